@@ -1,0 +1,413 @@
+//! Compressed sparse column matrices: an owned [`CscMatrix`] and a borrowed [`CscRef`].
+
+use crate::SolverError;
+use rayon::prelude::*;
+use sprs::{CompressedStorage, CsMatView};
+
+/// A borrowed CSC matrix: `col_ptr` (len ncols + 1), `row_idx` and `values` (len nnz).
+///
+/// Row indices are strictly increasing inside each column. Symmetric matrices store both
+/// triangles.
+#[derive(Clone, Copy, Debug)]
+pub struct CscRef<'a> {
+    nrows: usize,
+    ncols: usize,
+    col_ptr: &'a [usize],
+    row_idx: &'a [usize],
+    values: &'a [f64],
+}
+
+/// An owned CSC matrix with the same invariants as [`CscRef`].
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct CscMatrix {
+    nrows: usize,
+    ncols: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    values: Vec<f64>,
+}
+
+/// A cheap fingerprint of a sparsity pattern, to detect a changed pattern between analyze and
+/// factorize without keeping a copy of the indices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PatternFingerprint {
+    n: usize,
+    nnz: usize,
+    hash: u64,
+}
+
+fn check_structure(
+    nrows: usize,
+    ncols: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    nvalues: usize,
+) -> Result<(), SolverError> {
+    let bad = |m: String| Err(SolverError::InvalidMatrix(m));
+    if col_ptr.len() != ncols + 1 {
+        return bad(format!(
+            "col_ptr has {} entries, expected ncols + 1 = {}",
+            col_ptr.len(),
+            ncols + 1
+        ));
+    }
+    if col_ptr[0] != 0 {
+        return bad("col_ptr[0] must be 0".into());
+    }
+    let nnz = col_ptr[ncols];
+    if row_idx.len() != nnz || nvalues != nnz {
+        return bad(format!(
+            "col_ptr says {nnz} entries but row_idx has {} and values {nvalues}",
+            row_idx.len()
+        ));
+    }
+    for j in 0..ncols {
+        let (start, end) = (col_ptr[j], col_ptr[j + 1]);
+        if end < start || end > nnz {
+            return bad(format!("col_ptr is not non-decreasing at column {j}"));
+        }
+        let rows = &row_idx[start..end];
+        for (k, &r) in rows.iter().enumerate() {
+            if r >= nrows {
+                return bad(format!("row index {r} out of range in column {j}"));
+            }
+            if k > 0 && rows[k - 1] >= r {
+                return bad(format!(
+                    "row indices not strictly increasing in column {j}"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+impl<'a> CscRef<'a> {
+    /// Checks the arrays (sizes, bounds, sorted unique rows) and wraps them.
+    pub fn new(
+        nrows: usize,
+        ncols: usize,
+        col_ptr: &'a [usize],
+        row_idx: &'a [usize],
+        values: &'a [f64],
+    ) -> Result<Self, SolverError> {
+        check_structure(nrows, ncols, col_ptr, row_idx, values.len())?;
+        Ok(CscRef {
+            nrows,
+            ncols,
+            col_ptr,
+            row_idx,
+            values,
+        })
+    }
+
+    /// Borrows an sprs matrix without copying. It must be stored CSC with a plain (unsliced)
+    /// index pointer; use [`CscMatrix::from_sprs`] for any other sprs matrix.
+    pub fn try_from_sprs(m: &'a CsMatView<'_, f64>) -> Result<Self, SolverError> {
+        if m.storage() != CompressedStorage::CSC {
+            return Err(SolverError::InvalidMatrix(
+                "sprs matrix is stored CSR; convert it with CscMatrix::from_sprs".into(),
+            ));
+        }
+        let col_ptr = match m.proper_indptr() {
+            std::borrow::Cow::Borrowed(p) => p,
+            std::borrow::Cow::Owned(_) => {
+                return Err(SolverError::InvalidMatrix(
+                    "sprs matrix has an offset index pointer; use CscMatrix::from_sprs".into(),
+                ))
+            }
+        };
+        Self::new(m.rows(), m.cols(), col_ptr, m.indices(), m.data())
+    }
+
+    /// Number of rows.
+    pub fn nrows(&self) -> usize {
+        self.nrows
+    }
+    /// Number of columns.
+    pub fn ncols(&self) -> usize {
+        self.ncols
+    }
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+    /// Column pointers.
+    pub fn col_ptr(&self) -> &'a [usize] {
+        self.col_ptr
+    }
+    /// Row indices.
+    pub fn row_idx(&self) -> &'a [usize] {
+        self.row_idx
+    }
+    /// Values.
+    pub fn values(&self) -> &'a [f64] {
+        self.values
+    }
+    /// Row indices and values of column `j`.
+    pub fn col(&self, j: usize) -> (&'a [usize], &'a [f64]) {
+        let r = self.col_ptr[j]..self.col_ptr[j + 1];
+        (&self.row_idx[r.clone()], &self.values[r])
+    }
+
+    /// The diagonal (zero where not stored).
+    pub fn diagonal(&self) -> Vec<f64> {
+        (0..self.ncols.min(self.nrows))
+            .map(|j| {
+                let (rows, vals) = self.col(j);
+                rows.binary_search(&j).map(|k| vals[k]).unwrap_or(0.0)
+            })
+            .collect()
+    }
+
+    /// The fingerprint of the pattern.
+    pub fn fingerprint(&self) -> PatternFingerprint {
+        // FNV-1a over the indices; cheap compared with any factorization.
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for &x in self.col_ptr.iter().chain(self.row_idx.iter()) {
+            h ^= x as u64;
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+        PatternFingerprint {
+            n: self.ncols,
+            nnz: self.nnz(),
+            hash: h,
+        }
+    }
+
+    /// Returns the first value index holding a NaN or infinity.
+    pub fn first_non_finite(&self) -> Option<usize> {
+        self.values.iter().position(|v| !v.is_finite())
+    }
+
+    /// Whether `|a_ij − a_ji| ≤ tol · max|a|` for all entries (pattern must be symmetric too).
+    pub fn is_symmetric(&self, tol: f64) -> bool {
+        if self.nrows != self.ncols {
+            return false;
+        }
+        let scale = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        (0..self.ncols).all(|j| {
+            let (rows, vals) = self.col(j);
+            rows.iter().zip(vals).all(|(&i, &v)| {
+                let (ri, vi) = self.col(i);
+                match ri.binary_search(&j) {
+                    Ok(k) => (vi[k] - v).abs() <= tol * scale,
+                    Err(_) => v.abs() <= tol * scale,
+                }
+            })
+        })
+    }
+
+    /// y = A x, serial.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        for j in 0..self.ncols {
+            let xj = x[j];
+            let (rows, vals) = self.col(j);
+            for (&i, &v) in rows.iter().zip(vals) {
+                y[i] += v * xj;
+            }
+        }
+    }
+
+    /// y = A x for a **symmetric** A, in parallel: each column is read as a row (A = Aᵀ), so
+    /// every output entry is written by one task and the result does not depend on threads.
+    pub fn mul_vec_symmetric_par(&self, x: &[f64], y: &mut [f64]) {
+        const CHUNK: usize = 2048;
+        y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
+            for (k, yi) in out.iter_mut().enumerate() {
+                let (rows, vals) = self.col(c * CHUNK + k);
+                *yi = rows.iter().zip(vals).map(|(&r, &v)| v * x[r]).sum();
+            }
+        });
+    }
+
+    /// Copies into an owned matrix.
+    pub fn to_owned(&self) -> CscMatrix {
+        CscMatrix {
+            nrows: self.nrows,
+            ncols: self.ncols,
+            col_ptr: self.col_ptr.to_vec(),
+            row_idx: self.row_idx.to_vec(),
+            values: self.values.to_vec(),
+        }
+    }
+}
+
+impl CscMatrix {
+    /// Checks and takes ownership of the arrays.
+    pub fn new(
+        nrows: usize,
+        ncols: usize,
+        col_ptr: Vec<usize>,
+        row_idx: Vec<usize>,
+        values: Vec<f64>,
+    ) -> Result<Self, SolverError> {
+        check_structure(nrows, ncols, &col_ptr, &row_idx, values.len())?;
+        Ok(CscMatrix {
+            nrows,
+            ncols,
+            col_ptr,
+            row_idx,
+            values,
+        })
+    }
+
+    /// Builds a matrix from (row, col, value) triplets; duplicates are summed.
+    pub fn from_triplets(
+        nrows: usize,
+        ncols: usize,
+        triplets: &[(usize, usize, f64)],
+    ) -> Result<Self, SolverError> {
+        let mut t: Vec<_> = triplets.to_vec();
+        if let Some(&(i, j, _)) = t.iter().find(|&&(i, j, _)| i >= nrows || j >= ncols) {
+            return Err(SolverError::InvalidMatrix(format!(
+                "triplet ({i}, {j}) outside a {nrows}×{ncols} matrix"
+            )));
+        }
+        t.sort_by_key(|&(i, j, _)| (j, i));
+        let mut col_ptr = vec![0usize; ncols + 1];
+        let mut row_idx = Vec::with_capacity(t.len());
+        let mut values: Vec<f64> = Vec::with_capacity(t.len());
+        let mut last: Option<(usize, usize)> = None;
+        for (i, j, v) in t {
+            if last == Some((i, j)) {
+                if let Some(x) = values.last_mut() {
+                    *x += v;
+                }
+                continue;
+            }
+            last = Some((i, j));
+            row_idx.push(i);
+            values.push(v);
+            col_ptr[j + 1] += 1;
+        }
+        for j in 0..ncols {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        Self::new(nrows, ncols, col_ptr, row_idx, values)
+    }
+
+    /// Copies any sprs matrix (CSR or CSC, sliced or not) into CSC form.
+    pub fn from_sprs(m: CsMatView<'_, f64>) -> Result<Self, SolverError> {
+        let csc = if m.is_csc() {
+            m.to_owned()
+        } else {
+            m.to_csc()
+        };
+        let col_ptr = csc.indptr().to_proper().into_owned();
+        let base = col_ptr.first().copied().unwrap_or(0);
+        let col_ptr: Vec<usize> = col_ptr.iter().map(|p| p - base).collect();
+        let mut out = CscMatrix {
+            nrows: csc.rows(),
+            ncols: csc.cols(),
+            col_ptr,
+            row_idx: csc.indices().to_vec(),
+            values: csc.data().to_vec(),
+        };
+        // sprs allows unsorted indices in principle; sort each column to our invariant.
+        for j in 0..out.ncols {
+            let r = out.col_ptr[j]..out.col_ptr[j + 1];
+            let mut pairs: Vec<(usize, f64)> = out.row_idx[r.clone()]
+                .iter()
+                .copied()
+                .zip(out.values[r.clone()].iter().copied())
+                .collect();
+            pairs.sort_by_key(|p| p.0);
+            for (k, (i, v)) in r.zip(pairs) {
+                out.row_idx[k] = i;
+                out.values[k] = v;
+            }
+        }
+        check_structure(
+            out.nrows,
+            out.ncols,
+            &out.col_ptr,
+            &out.row_idx,
+            out.values.len(),
+        )?;
+        Ok(out)
+    }
+
+    /// Converts to an sprs CSC matrix (for tools that work with sprs).
+    pub fn to_sprs(&self) -> sprs::CsMat<f64> {
+        sprs::CsMat::new_csc(
+            (self.nrows, self.ncols),
+            self.col_ptr.clone(),
+            self.row_idx.clone(),
+            self.values.clone(),
+        )
+    }
+
+    /// Borrows as a [`CscRef`].
+    pub fn as_ref(&self) -> CscRef<'_> {
+        CscRef {
+            nrows: self.nrows,
+            ncols: self.ncols,
+            col_ptr: &self.col_ptr,
+            row_idx: &self.row_idx,
+            values: &self.values,
+        }
+    }
+
+    /// Mutable access to the values (the pattern stays fixed).
+    pub fn values_mut(&mut self) -> &mut [f64] {
+        &mut self.values
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_unsorted_rows_and_bad_pointers() {
+        let e = CscRef::new(2, 2, &[0, 2, 3], &[1, 0, 1], &[1.0, 2.0, 3.0]).unwrap_err();
+        assert!(e.to_string().contains("strictly increasing in column 0"), "{e}");
+        let e = CscRef::new(2, 2, &[0, 2], &[0, 1], &[1.0, 2.0]).unwrap_err();
+        assert!(e.to_string().contains("ncols + 1"), "{e}");
+        let e = CscRef::new(2, 2, &[0, 1, 2], &[0, 5], &[1.0, 2.0]).unwrap_err();
+        assert!(e.to_string().contains("out of range"), "{e}");
+    }
+
+    #[test]
+    fn sprs_round_trip_csr_and_csc() {
+        let a = CscMatrix::from_triplets(
+            3,
+            3,
+            &[(0, 0, 4.0), (1, 0, 1.0), (0, 1, 1.0), (1, 1, 3.0), (2, 2, 2.0), (2, 2, 0.5)],
+        )
+        .unwrap();
+        let s = a.to_sprs();
+        let back = CscMatrix::from_sprs(s.view()).unwrap();
+        assert_eq!(back, a);
+        let csr = s.to_csr();
+        assert_eq!(CscMatrix::from_sprs(csr.view()).unwrap(), a);
+        assert!(CscRef::try_from_sprs(&csr.view()).is_err());
+        let sv = s.view();
+        let borrowed = CscRef::try_from_sprs(&sv).unwrap();
+        assert_eq!(borrowed.values(), a.as_ref().values());
+        assert_eq!(a.as_ref().diagonal(), vec![4.0, 3.0, 2.5]);
+    }
+
+    #[test]
+    fn parallel_symmetric_spmv_matches_serial() {
+        let n = 5000;
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push((i, i, 4.0 + i as f64 * 1e-3));
+            if i + 7 < n {
+                t.push((i, i + 7, -1.0));
+                t.push((i + 7, i, -1.0));
+            }
+        }
+        let a = CscMatrix::from_triplets(n, n, &t).unwrap();
+        let x: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let (mut y1, mut y2) = (vec![0.0; n], vec![0.0; n]);
+        a.as_ref().mul_vec(&x, &mut y1);
+        a.as_ref().mul_vec_symmetric_par(&x, &mut y2);
+        for (p, q) in y1.iter().zip(&y2) {
+            assert!((p - q).abs() <= 1e-14 * p.abs().max(1.0));
+        }
+        assert!(a.as_ref().is_symmetric(0.0));
+    }
+}

@@ -1,0 +1,29 @@
+//! The sparse linear solver layer of fibercell, usable on its own.
+//!
+//! It knows nothing about fibers: it takes square sparse matrices in compressed sparse column
+//! (CSC) form — its own [`CscRef`] views or [`sprs`] matrices through [`CscMatrix::from_sprs`] /
+//! [`CscRef::try_from_sprs`] — and offers
+//!
+//! * the [`LinearSolver`] trait with separate *analyze* (ordering + symbolic factorization, once
+//!   per sparsity pattern), *factorize* (numeric, whenever values change) and *solve* (any number of
+//!   right-hand sides) phases;
+//! * fill-reducing [`Ordering`]s: approximate minimum degree, nested dissection (METIS
+//!   `METIS_NodeND`), natural or a given permutation;
+//! * typed [`SolverError`]s and [`solve_checked`], which reports the relative residual
+//!   ‖Ax − b‖/‖b‖ of every solve and never returns a non-finite solution.
+//!
+//! Backends live in their own crates (`fibercell-faer`, `fibercell-cg`, `fibercell-cholmod`).
+//! Symmetric matrices are always passed with **both triangles stored**; Cholesky backends read
+//! the lower one.
+
+mod csc;
+mod error;
+mod ordering;
+mod residual;
+mod solver;
+
+pub use csc::{CscMatrix, CscRef, PatternFingerprint};
+pub use error::{SolverError, StopReason};
+pub use ordering::{compute_ordering, Ordering, Permutation};
+pub use residual::{relative_residual, solve_checked, SolveReport};
+pub use solver::{AnalyzeInfo, Capabilities, LinearSolver, SolveInfo};

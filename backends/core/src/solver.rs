@@ -1,0 +1,105 @@
+//! The [`LinearSolver`] trait: analyze / factorize / solve.
+
+use crate::{CscRef, SolverError, StopReason};
+
+/// What a backend can do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Capabilities {
+    /// Only symmetric (positive definite) matrices.
+    pub symmetric_only: bool,
+    /// `analyze` is done once per pattern and reused by every `factorize`.
+    pub reuses_symbolic: bool,
+    /// An iterative method (the solve has a tolerance and may not converge).
+    pub iterative: bool,
+    /// Honours the requested fill-reducing [`crate::Ordering`].
+    pub selectable_ordering: bool,
+}
+
+/// What `analyze` found.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AnalyzeInfo {
+    /// Order of the matrix.
+    pub n: usize,
+    /// Stored entries of A (both triangles).
+    pub nnz_a: usize,
+    /// Entries of the factor L (or L + U), when a direct method.
+    pub nnz_factor: Option<usize>,
+    /// Floating point operations of one numeric factorization, when known.
+    pub flops: Option<f64>,
+    /// The ordering that was used.
+    pub ordering: String,
+}
+
+/// What `solve_in_place` reports.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolveInfo {
+    /// Iterations (iterative methods; the largest over the right-hand sides).
+    pub iterations: Option<usize>,
+    /// The backend's own relative residual estimate (iterative methods).
+    pub residual_estimate: Option<f64>,
+    /// Why an iterative method stopped.
+    pub stop: Option<StopReason>,
+}
+
+/// A sparse linear solver with separate symbolic, numeric and solve phases.
+///
+/// Call order: `analyze` once per sparsity pattern, then `factorize` whenever the values change
+/// (same pattern), then `solve_in_place` for any number of right-hand sides.
+pub trait LinearSolver: Send {
+    /// Short name, e.g. `"faer-cholesky"`.
+    fn name(&self) -> &'static str;
+    /// What the backend can do.
+    fn capabilities(&self) -> Capabilities;
+    /// Ordering and symbolic factorization; only the pattern of `a` is used.
+    fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError>;
+    /// Numeric factorization of `a`, whose pattern must be the analysed one.
+    fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError>;
+    /// Solves A X = B in place; `rhs` holds `nrhs` columns of length n, column after column.
+    fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError>;
+}
+
+
+impl dyn LinearSolver {
+    /// Checks that `rhs` holds `nrhs` columns of length `n`.
+    pub fn check_rhs(n: usize, rhs: &[f64], nrhs: usize) -> Result<(), SolverError> {
+        if rhs.len() != n * nrhs {
+            return Err(SolverError::DimensionMismatch(format!(
+                "right-hand side has {} values, expected {n} × {nrhs}",
+                rhs.len()
+            )));
+        }
+        if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
+            return Err(SolverError::NonFinite {
+                what: "right-hand side",
+                index: i,
+            });
+        }
+        Ok(())
+    }
+
+    /// Checks that the matrix is square, of order `n` when given, with finite values.
+    pub fn check_matrix(a: CscRef<'_>, n: Option<usize>) -> Result<(), SolverError> {
+        if a.nrows() != a.ncols() {
+            return Err(SolverError::DimensionMismatch(format!(
+                "matrix is {}×{}, not square",
+                a.nrows(),
+                a.ncols()
+            )));
+        }
+        if let Some(n) = n {
+            if a.ncols() != n {
+                return Err(SolverError::DimensionMismatch(format!(
+                    "matrix has order {}, analysed order was {n}",
+                    a.ncols()
+                )));
+            }
+        }
+        if let Some(i) = a.first_non_finite() {
+            return Err(SolverError::NonFinite {
+                what: "matrix",
+                index: i,
+            });
+        }
+        Ok(())
+    }
+}
