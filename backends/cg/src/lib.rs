@@ -1,1 +1,213 @@
+//! Preconditioned conjugate gradients for symmetric positive definite systems, with a
+//! node-block Jacobi preconditioner (the inverse of each diagonal block, 6×6 for frame nodes)
+//! and a rayon-parallel sparse matrix-vector product.
 
+mod block_jacobi;
+
+pub use block_jacobi::BlockJacobi;
+use fibercell_solver::{
+    AnalyzeInfo, Capabilities, CscMatrix, CscRef, LinearSolver, PatternFingerprint, SolveInfo,
+    SolverError, StopReason,
+};
+
+/// Preconditioned conjugate gradients.
+pub struct ConjugateGradient {
+    tolerance: f64,
+    max_iterations: Option<usize>,
+    block_starts: Option<Vec<usize>>,
+    block_size: usize,
+    pattern: Option<PatternFingerprint>,
+    state: Option<(CscMatrix, BlockJacobi)>,
+}
+
+impl Default for ConjugateGradient {
+    fn default() -> Self {
+        ConjugateGradient {
+            tolerance: 1e-12,
+            max_iterations: None,
+            block_starts: None,
+            block_size: 6,
+            pattern: None,
+            state: None,
+        }
+    }
+}
+
+impl ConjugateGradient {
+    /// Relative residual tolerance 1e-12, at most 10·n iterations, blocks of 6 unknowns.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Stop when ‖r‖/‖b‖ ≤ `tol`.
+    pub fn with_tolerance(mut self, tol: f64) -> Self {
+        self.tolerance = tol;
+        self
+    }
+
+    /// Iteration limit (default 10·n).
+    pub fn with_max_iterations(mut self, k: usize) -> Self {
+        self.max_iterations = Some(k);
+        self
+    }
+
+    /// Uniform preconditioner blocks of `size` consecutive unknowns (default 6).
+    pub fn with_block_size(mut self, size: usize) -> Self {
+        self.block_size = size.max(1);
+        self.block_starts = None;
+        self
+    }
+
+    /// Preconditioner blocks given by their first unknowns (e.g. the free DOFs of each node);
+    /// must start at 0 and increase.
+    pub fn with_blocks(mut self, starts: Vec<usize>) -> Self {
+        self.block_starts = Some(starts);
+        self
+    }
+
+    fn starts(&self, n: usize) -> Result<Vec<usize>, SolverError> {
+        match &self.block_starts {
+            Some(s) => {
+                let ok = s.first() == Some(&0) && s.windows(2).all(|w| w[0] < w[1]) && s.last().is_some_and(|&l| l < n.max(1));
+                if ok || (n == 0 && s.is_empty()) {
+                    Ok(s.clone())
+                } else {
+                    Err(SolverError::DimensionMismatch(format!(
+                        "preconditioner blocks must start at 0, increase and stay below {n}"
+                    )))
+                }
+            }
+            None => Ok((0..n).step_by(self.block_size).collect()),
+        }
+    }
+
+    fn solve_one(&self, a: CscRef<'_>, pre: &BlockJacobi, b: &mut [f64]) -> (usize, f64, StopReason) {
+        let n = b.len();
+        let bnorm = norm(b);
+        if bnorm == 0.0 {
+            return (0, 0.0, StopReason::Converged);
+        }
+        let max_it = self.max_iterations.unwrap_or(10 * n.max(1));
+        let mut x = vec![0.0; n];
+        let mut r = b.to_vec();
+        let mut z = vec![0.0; n];
+        pre.apply(&r, &mut z);
+        let mut p = z.clone();
+        let mut ap = vec![0.0; n];
+        let mut rz = dot(&r, &z);
+        let mut rel = 1.0;
+        let mut it = 0;
+        let reason = loop {
+            if rel <= self.tolerance {
+                break StopReason::Converged;
+            }
+            if it >= max_it {
+                break StopReason::MaxIterations;
+            }
+            a.mul_vec_symmetric_par(&p, &mut ap);
+            let pap = dot(&p, &ap);
+            if !pap.is_finite() || !rz.is_finite() {
+                break StopReason::NonFinite;
+            }
+            if pap <= 0.0 {
+                break StopReason::Breakdown;
+            }
+            let alpha = rz / pap;
+            x.iter_mut().zip(&p).for_each(|(xi, pi)| *xi += alpha * pi);
+            r.iter_mut().zip(&ap).for_each(|(ri, api)| *ri -= alpha * api);
+            pre.apply(&r, &mut z);
+            let rz_new = dot(&r, &z);
+            let beta = rz_new / rz;
+            rz = rz_new;
+            p.iter_mut().zip(&z).for_each(|(pi, zi)| *pi = zi + beta * *pi);
+            rel = norm(&r) / bnorm;
+            it += 1;
+        };
+        b.copy_from_slice(&x);
+        (it, rel, reason)
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm(a: &[f64]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+impl LinearSolver for ConjugateGradient {
+    fn name(&self) -> &'static str {
+        "cg"
+    }
+
+    fn capabilities(&self) -> Capabilities {
+        Capabilities {
+            symmetric_only: true,
+            reuses_symbolic: true,
+            iterative: true,
+            selectable_ordering: false,
+        }
+    }
+
+    fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError> {
+        <dyn LinearSolver>::check_matrix(a, None)?;
+        self.starts(a.ncols())?;
+        self.pattern = Some(a.fingerprint());
+        self.state = None;
+        Ok(AnalyzeInfo {
+            n: a.ncols(),
+            nnz_a: a.nnz(),
+            nnz_factor: None,
+            flops: None,
+            ordering: "none".into(),
+        })
+    }
+
+    fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError> {
+        let fp = self.pattern.ok_or(SolverError::OutOfOrder("factorize", "analyze"))?;
+        <dyn LinearSolver>::check_matrix(a, None)?;
+        if a.fingerprint() != fp {
+            return Err(SolverError::PatternChanged);
+        }
+        if !a.is_symmetric(1e-12) {
+            return Err(SolverError::NotSymmetric("cg"));
+        }
+        let pre = BlockJacobi::new(a, &self.starts(a.ncols())?)?;
+        // Keep the values (the pattern is the analysed one); reuse the allocation if possible.
+        match &mut self.state {
+            Some((m, p)) => {
+                m.values_mut().copy_from_slice(a.values());
+                *p = pre;
+            }
+            None => self.state = Some((a.to_owned(), pre)),
+        }
+        Ok(())
+    }
+
+    fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError> {
+        let (m, pre) = self.state.as_ref().ok_or(SolverError::OutOfOrder("solve", "factorize"))?;
+        let a = m.as_ref();
+        let n = a.ncols();
+        <dyn LinearSolver>::check_rhs(n, rhs, nrhs)?;
+        let mut info = SolveInfo {
+            iterations: Some(0),
+            residual_estimate: Some(0.0),
+            stop: Some(StopReason::Converged),
+        };
+        for col in rhs.chunks_mut(n.max(1)).take(nrhs) {
+            let (it, rel, reason) = self.solve_one(a, pre, col);
+            if reason != StopReason::Converged {
+                return Err(SolverError::NoConvergence {
+                    iterations: it,
+                    residual: rel,
+                    tolerance: self.tolerance,
+                    reason,
+                });
+            }
+            info.iterations = info.iterations.map(|k| k.max(it));
+            info.residual_estimate = info.residual_estimate.map(|r| r.max(rel));
+        }
+        Ok(info)
+    }
+}

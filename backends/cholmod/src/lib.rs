@@ -1,1 +1,306 @@
+//! SuiteSparse CHOLMOD through `suitesparse_sys`, as a fibercell [`LinearSolver`].
+//!
+//! Needs Debian's `libsuitesparse-dev` (and `libclang-dev` for the bindings). All C memory is
+//! owned by RAII wrappers and freed in `Drop`. CHOLMOD reports a non-positive-definite matrix as
+//! a *warning* (`status = CHOLMOD_NOT_POSDEF`, `L->minor < n`) while returning success: both are
+//! checked after every factorization.
 
+mod common;
+
+use common::Common;
+use fibercell_solver::{
+    compute_ordering, AnalyzeInfo, Capabilities, CscRef, LinearSolver, Ordering,
+    PatternFingerprint, SolveInfo, SolverError,
+};
+use std::os::raw::{c_int, c_long, c_void};
+use suitesparse_sys as ss;
+
+/// CHOLMOD sparse Cholesky (supernodal or simplicial, CHOLMOD's choice).
+pub struct Cholmod {
+    ordering: Ordering,
+    pivot_tolerance: f64,
+    common: Option<Common>,
+    state: Option<State>,
+}
+
+struct State {
+    n: usize,
+    fingerprint: PatternFingerprint,
+    col_ptr: Vec<c_long>,
+    row_idx: Vec<c_long>,
+    lower_src: Vec<usize>,
+    values: Vec<f64>,
+    scale: Vec<f64>,
+    factor: *mut ss::cholmod_factor,
+    factorized: bool,
+}
+
+// SAFETY: the CHOLMOD objects are plain heap memory not tied to a thread; `Cholmod` owns them
+// exclusively and every access goes through `&mut self`.
+unsafe impl Send for Cholmod {}
+
+impl Default for Cholmod {
+    fn default() -> Self {
+        Self::new(Ordering::Auto)
+    }
+}
+
+impl Cholmod {
+    /// A solver with the given ordering ([`Ordering::Auto`]: CHOLMOD's default strategy).
+    pub fn new(ordering: Ordering) -> Self {
+        Cholmod {
+            ordering,
+            pivot_tolerance: 1e-12,
+            common: None,
+            state: None,
+        }
+    }
+
+    /// Reciprocal condition estimates (of the diagonally scaled matrix) below this are
+    /// rejected as singular (default 1e-12).
+    pub fn with_pivot_tolerance(mut self, tol: f64) -> Self {
+        self.pivot_tolerance = tol;
+        self
+    }
+
+    fn free_factor(&mut self) {
+        if let (Some(c), Some(s)) = (self.common.as_mut(), self.state.as_mut()) {
+            if !s.factor.is_null() {
+                // SAFETY: `factor` came from cholmod_l_analyze_p with this common.
+                unsafe { ss::cholmod_l_free_factor(&mut s.factor, c.as_mut_ptr()) };
+                s.factor = std::ptr::null_mut();
+            }
+        }
+    }
+}
+
+impl Drop for Cholmod {
+    fn drop(&mut self) {
+        self.free_factor();
+        // `Common` finishes itself in its own Drop, after the factor is gone.
+    }
+}
+
+impl State {
+    /// A CHOLMOD header over our own lower-triangle arrays (never freed by CHOLMOD).
+    fn header(&mut self) -> ss::cholmod_sparse {
+        ss::cholmod_sparse {
+            nrow: self.n,
+            ncol: self.n,
+            nzmax: self.row_idx.len(),
+            p: self.col_ptr.as_mut_ptr() as *mut c_void,
+            i: self.row_idx.as_mut_ptr() as *mut c_void,
+            nz: std::ptr::null_mut(),
+            x: self.values.as_mut_ptr() as *mut c_void,
+            z: std::ptr::null_mut(),
+            stype: -1,
+            itype: ss::CHOLMOD_LONG as c_int,
+            xtype: ss::CHOLMOD_REAL as c_int,
+            dtype: ss::CHOLMOD_DOUBLE as c_int,
+            sorted: 1,
+            packed: 1,
+        }
+    }
+}
+
+fn backend_error(code: c_int, what: &str) -> SolverError {
+    if code == ss::CHOLMOD_OUT_OF_MEMORY {
+        return SolverError::OutOfMemory;
+    }
+    SolverError::Backend {
+        backend: "cholmod",
+        code: code as i64,
+        message: format!("{what} failed (CHOLMOD status {code})"),
+    }
+}
+
+impl LinearSolver for Cholmod {
+    fn name(&self) -> &'static str {
+        "cholmod"
+    }
+
+    fn capabilities(&self) -> Capabilities {
+        Capabilities {
+            symmetric_only: true,
+            reuses_symbolic: true,
+            iterative: false,
+            selectable_ordering: true,
+        }
+    }
+
+    fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError> {
+        <dyn LinearSolver>::check_matrix(a, None)?;
+        self.free_factor();
+        self.state = None;
+        if self.common.is_none() {
+            self.common = Some(Common::start()?);
+        }
+        let n = a.ncols();
+        let too_big = || SolverError::InvalidMatrix("index does not fit CHOLMOD's long".into());
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        let mut lower_src = Vec::new();
+        col_ptr.push(0);
+        for j in 0..n {
+            let start = a.col_ptr()[j];
+            for (k, &i) in a.col(j).0.iter().enumerate() {
+                if i >= j {
+                    row_idx.push(c_long::try_from(i).map_err(|_| too_big())?);
+                    lower_src.push(start + k);
+                }
+            }
+            col_ptr.push(c_long::try_from(row_idx.len()).map_err(|_| too_big())?);
+        }
+        let mut perm: Option<Vec<c_long>> = None;
+        let (nmethods, method, name) = match &self.ordering {
+            Ordering::Auto => (0, ss::CHOLMOD_AMD, "cholmod-default"),
+            Ordering::Natural => (1, ss::CHOLMOD_NATURAL, "natural"),
+            Ordering::Amd => (1, ss::CHOLMOD_AMD, "amd"),
+            o @ (Ordering::NestedDissection | Ordering::Given(_)) => {
+                let p = compute_ordering(a, o)?;
+                perm = Some(p.fwd.iter().map(|&x| x as c_long).collect());
+                (1, ss::CHOLMOD_GIVEN, o.name())
+            }
+        };
+        let nnz = lower_src.len();
+        let mut state = State {
+            n,
+            fingerprint: a.fingerprint(),
+            col_ptr,
+            row_idx,
+            lower_src,
+            values: vec![0.0; nnz],
+            scale: vec![1.0; n],
+            factor: std::ptr::null_mut(),
+            factorized: false,
+        };
+        let common = self.common.as_mut().ok_or(SolverError::OutOfOrder("analyze", "start"))?;
+        let c = common.as_mut_ptr();
+        let mut header = state.header();
+        // SAFETY: `c` is a started common; the header points to live arrays of the declared
+        // sizes; `perm` (if any) has n entries.
+        let (factor, status, lnz, fl) = unsafe {
+            (*c).nmethods = nmethods;
+            (*c).method[0].ordering = method as c_int;
+            (*c).postorder = 1;
+            let pp = perm.as_mut().map_or(std::ptr::null_mut(), |p| p.as_mut_ptr());
+            let f = ss::cholmod_l_analyze_p(&mut header, pp, std::ptr::null_mut(), 0, c);
+            (f, (*c).status, (*c).lnz, (*c).fl)
+        };
+        if factor.is_null() || status < 0 {
+            return Err(backend_error(status, "cholmod_l_analyze_p"));
+        }
+        state.factor = factor;
+        self.state = Some(state);
+        Ok(AnalyzeInfo {
+            n,
+            nnz_a: a.nnz(),
+            nnz_factor: Some(lnz as usize),
+            flops: Some(fl),
+            ordering: name.to_string(),
+        })
+    }
+
+    fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError> {
+        let tol = self.pivot_tolerance;
+        let (common, s) = match (self.common.as_mut(), self.state.as_mut()) {
+            (Some(c), Some(s)) => (c, s),
+            _ => return Err(SolverError::OutOfOrder("factorize", "analyze")),
+        };
+        <dyn LinearSolver>::check_matrix(a, Some(s.n))?;
+        if a.fingerprint() != s.fingerprint {
+            return Err(SolverError::PatternChanged);
+        }
+        s.factorized = false;
+        for j in 0..s.n {
+            let first = s.col_ptr[j] as usize;
+            let ajj = if s.row_idx.get(first) == Some(&(j as c_long)) {
+                a.values()[s.lower_src[first]]
+            } else {
+                0.0
+            };
+            if !(ajj > 0.0) {
+                return Err(SolverError::NotPositiveDefinite { column: j, pivot: ajj });
+            }
+            s.scale[j] = 1.0 / ajj.sqrt();
+        }
+        for j in 0..s.n {
+            for k in s.col_ptr[j] as usize..s.col_ptr[j + 1] as usize {
+                let i = s.row_idx[k] as usize;
+                s.values[k] = a.values()[s.lower_src[k]] * s.scale[i] * s.scale[j];
+            }
+        }
+        let c = common.as_mut_ptr();
+        let mut header = s.header();
+        // SAFETY: factor and common are live and belong together; header points to live arrays.
+        let (ok, status, minor, rcond) = unsafe {
+            let ok = ss::cholmod_l_factorize(&mut header, s.factor, c);
+            let rcond = ss::cholmod_l_rcond(s.factor, c);
+            (ok, (*c).status, (*s.factor).minor, rcond)
+        };
+        if ok == 0 || status < 0 {
+            return Err(backend_error(status, "cholmod_l_factorize"));
+        }
+        if status == ss::CHOLMOD_NOT_POSDEF as c_int || minor < s.n {
+            // SAFETY: after analyze, Perm holds n longs (`minor` < n is a factor position).
+            let column = unsafe {
+                let perm = (*s.factor).Perm as *const c_long;
+                if perm.is_null() || minor >= s.n {
+                    minor.min(s.n.saturating_sub(1))
+                } else {
+                    *perm.add(minor) as usize
+                }
+            };
+            return Err(SolverError::NotPositiveDefinite { column, pivot: 0.0 });
+        }
+        if !(rcond > tol) {
+            return Err(SolverError::Singular {
+                column: None,
+                detail: format!("CHOLMOD reciprocal condition estimate {rcond:.3e} of the scaled matrix"),
+            });
+        }
+        s.factorized = true;
+        Ok(())
+    }
+
+    fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError> {
+        let (common, s) = match (self.common.as_mut(), self.state.as_mut()) {
+            (Some(c), Some(s)) if s.factorized => (c, s),
+            _ => return Err(SolverError::OutOfOrder("solve", "factorize")),
+        };
+        let n = s.n;
+        <dyn LinearSolver>::check_rhs(n, rhs, nrhs)?;
+        if n == 0 || nrhs == 0 {
+            return Ok(SolveInfo::default());
+        }
+        for col in rhs.chunks_mut(n) {
+            col.iter_mut().zip(&s.scale).for_each(|(x, d)| *x *= d);
+        }
+        let mut b = ss::cholmod_dense {
+            nrow: n,
+            ncol: nrhs,
+            nzmax: n * nrhs,
+            d: n,
+            x: rhs.as_mut_ptr() as *mut c_void,
+            z: std::ptr::null_mut(),
+            xtype: ss::CHOLMOD_REAL as c_int,
+            dtype: ss::CHOLMOD_DOUBLE as c_int,
+        };
+        let c = common.as_mut_ptr();
+        // SAFETY: `b` describes `rhs` (n × nrhs, leading dimension n); the result is a new
+        // dense matrix that we copy out of and free with the same common.
+        unsafe {
+            let mut x = ss::cholmod_l_solve(ss::CHOLMOD_A as c_int, s.factor, &mut b, c);
+            if x.is_null() {
+                return Err(backend_error((*c).status, "cholmod_l_solve"));
+            }
+            let src = std::slice::from_raw_parts((*x).x as *const f64, n * nrhs);
+            rhs.copy_from_slice(src);
+            ss::cholmod_l_free_dense(&mut x, c);
+        }
+        for col in rhs.chunks_mut(n) {
+            col.iter_mut().zip(&s.scale).for_each(|(x, d)| *x *= d);
+        }
+        Ok(SolveInfo::default())
+    }
+}

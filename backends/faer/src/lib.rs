@@ -1,1 +1,10 @@
+//! faer sparse backends for the fibercell solver layer: supernodal/simplicial Cholesky
+//! ([`FaerCholesky`], LLᵀ or LDLᵀ, symbolic analysis reused) and LU ([`FaerLu`], for the
+//! nonsymmetric systems of Coulomb sliding). No system packages needed.
 
+mod cholesky;
+mod lu;
+mod pivots;
+
+pub use cholesky::{CholeskyVariant, FaerCholesky};
+pub use lu::FaerLu;

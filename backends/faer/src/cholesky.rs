@@ -1,0 +1,312 @@
+//! Sparse Cholesky through faer with the symbolic analysis kept across factorizations.
+//!
+//! The matrix is factorized in the symmetrically scaled form S A S with S = diag(a_jj)^(-1/2),
+//! so every pivot can be judged relative to its own diagonal entry: a pivot below
+//! `pivot_tolerance` is reported as [`SolverError::NotPositiveDefinite`] at the original column,
+//! which is how a mechanism (a fiber held by nothing) shows up instead of a garbage solution.
+
+use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side, Spec};
+use fibercell_solver::{
+    compute_ordering, AnalyzeInfo, Capabilities, CscRef, LinearSolver, Ordering,
+    PatternFingerprint, Permutation, SolveInfo, SolverError,
+};
+
+/// LLᵀ or LDLᵀ (no square roots; same sparsity).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CholeskyVariant {
+    /// L Lᵀ.
+    #[default]
+    Llt,
+    /// L D Lᵀ with unit L.
+    Ldlt,
+}
+
+/// faer sparse Cholesky for symmetric positive definite matrices (both triangles stored; the
+/// lower one is read).
+pub struct FaerCholesky {
+    variant: CholeskyVariant,
+    ordering: Ordering,
+    pivot_tolerance: f64,
+    par: Par,
+    analysis: Option<Analysis>,
+    factor: Option<Factor>,
+}
+
+struct Analysis {
+    n: usize,
+    fingerprint: PatternFingerprint,
+    lower_col_ptr: Vec<usize>,
+    lower_row_idx: Vec<usize>,
+    /// For every entry of the lower triangle, its index in the full matrix's values.
+    lower_src: Vec<usize>,
+    /// The permutation faer factorizes with (`fwd[new] = old`).
+    perm: Permutation,
+    symbolic: SymbolicCholesky<usize>,
+}
+
+struct Factor {
+    l_values: Vec<f64>,
+    scale: Vec<f64>,
+    lower_values: Vec<f64>,
+}
+
+impl Default for FaerCholesky {
+    fn default() -> Self {
+        Self::new(CholeskyVariant::Llt, Ordering::Auto)
+    }
+}
+
+impl FaerCholesky {
+    /// A solver with the given variant and ordering, relative pivot tolerance 1e-12 and all
+    /// rayon threads.
+    pub fn new(variant: CholeskyVariant, ordering: Ordering) -> Self {
+        FaerCholesky {
+            variant,
+            ordering,
+            pivot_tolerance: 1e-12,
+            par: Par::rayon(0),
+            analysis: None,
+            factor: None,
+        }
+    }
+
+    /// Pivots of the diagonally scaled matrix below this are rejected (default 1e-12).
+    pub fn with_pivot_tolerance(mut self, tol: f64) -> Self {
+        self.pivot_tolerance = tol;
+        self
+    }
+
+    /// Runs single-threaded.
+    pub fn sequential(mut self) -> Self {
+        self.par = Par::Seq;
+        self
+    }
+
+    fn symbolic_for(
+        &self,
+        lower: SymbolicSparseColMatRef<'_, usize>,
+        perm: &Permutation,
+    ) -> Result<SymbolicCholesky<usize>, SolverError> {
+        let n = perm.fwd.len();
+        let p = PermRef::new_checked(&perm.fwd, &perm.inv, n);
+        factorize_symbolic_cholesky(
+            lower,
+            Side::Lower,
+            SymmetricOrdering::Custom(p),
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| SolverError::Backend {
+            backend: "faer-cholesky",
+            code: -1,
+            message: format!("symbolic factorization failed: {e:?}"),
+        })
+    }
+}
+
+fn pivot_error(column: usize, pivot: f64) -> SolverError {
+    SolverError::NotPositiveDefinite { column, pivot }
+}
+
+impl LinearSolver for FaerCholesky {
+    fn name(&self) -> &'static str {
+        "faer-cholesky"
+    }
+
+    fn capabilities(&self) -> Capabilities {
+        Capabilities {
+            symmetric_only: true,
+            reuses_symbolic: true,
+            iterative: false,
+            selectable_ordering: true,
+        }
+    }
+
+    fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError> {
+        <dyn LinearSolver>::check_matrix(a, None)?;
+        self.factor = None;
+        self.analysis = None;
+        let n = a.ncols();
+        let mut lower_col_ptr = Vec::with_capacity(n + 1);
+        let mut lower_row_idx = Vec::new();
+        let mut lower_src = Vec::new();
+        lower_col_ptr.push(0);
+        for j in 0..n {
+            let start = a.col_ptr()[j];
+            for (k, &i) in a.col(j).0.iter().enumerate() {
+                if i >= j {
+                    lower_row_idx.push(i);
+                    lower_src.push(start + k);
+                }
+            }
+            lower_col_ptr.push(lower_row_idx.len());
+        }
+        let lower = SymbolicSparseColMatRef::new_checked(n, n, &lower_col_ptr, None, &lower_row_idx);
+        let (perm, symbolic, name) = match &self.ordering {
+            Ordering::Auto => {
+                // Both candidates, keep the one with fewer predicted flops.
+                let mut best: Option<(Permutation, SymbolicCholesky<usize>, f64, &str)> = None;
+                for (o, nm) in [(Ordering::Amd, "auto→amd"), (Ordering::NestedDissection, "auto→nested-dissection")] {
+                    let p = compute_ordering(a, &o)?;
+                    let s = self.symbolic_for(lower, &p)?;
+                    let flops = fill_and_flops(&s).1;
+                    if best.as_ref().is_none_or(|b| flops < b.2) {
+                        best = Some((p, s, flops, nm));
+                    }
+                }
+                let (p, s, _, nm) = best.ok_or(SolverError::OutOfMemory)?;
+                (p, s, nm.to_string())
+            }
+            o => {
+                let p = compute_ordering(a, o)?;
+                let s = self.symbolic_for(lower, &p)?;
+                (p, s, o.name().to_string())
+            }
+        };
+        let (nnz_l, flops) = fill_and_flops(&symbolic);
+        let info = AnalyzeInfo {
+            n,
+            nnz_a: a.nnz(),
+            nnz_factor: Some(nnz_l),
+            flops: Some(flops),
+            ordering: name,
+        };
+        self.analysis = Some(Analysis {
+            n,
+            fingerprint: a.fingerprint(),
+            lower_col_ptr,
+            lower_row_idx,
+            lower_src,
+            perm,
+            symbolic,
+        });
+        Ok(info)
+    }
+
+    fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError> {
+        let an = self
+            .analysis
+            .as_ref()
+            .ok_or(SolverError::OutOfOrder("factorize", "analyze"))?;
+        <dyn LinearSolver>::check_matrix(a, Some(an.n))?;
+        if a.fingerprint() != an.fingerprint {
+            return Err(SolverError::PatternChanged);
+        }
+        let n = an.n;
+        // Reuse the buffers of the previous factorization when there is one.
+        let mut f = self.factor.take().unwrap_or_else(|| Factor {
+            l_values: vec![0.0; an.symbolic.len_val()],
+            scale: vec![0.0; n],
+            lower_values: vec![0.0; an.lower_src.len()],
+        });
+        for j in 0..n {
+            let d = an.lower_src[an.lower_col_ptr[j]];
+            let ajj = a.values()[d];
+            if an.lower_row_idx[an.lower_col_ptr[j]] != j || !(ajj > 0.0) {
+                return Err(pivot_error(j, if an.lower_row_idx[an.lower_col_ptr[j]] == j { ajj } else { 0.0 }));
+            }
+            f.scale[j] = 1.0 / ajj.sqrt();
+        }
+        for j in 0..n {
+            for k in an.lower_col_ptr[j]..an.lower_col_ptr[j + 1] {
+                let i = an.lower_row_idx[k];
+                f.lower_values[k] = a.values()[an.lower_src[k]] * f.scale[i] * f.scale[j];
+            }
+        }
+        let lower = SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_checked(n, n, &an.lower_col_ptr, None, &an.lower_row_idx),
+            &f.lower_values,
+        );
+        let sym = &an.symbolic;
+        let first_pivot_index = |index: usize| {
+            let k = if is_simplicial(sym) { index.saturating_sub(1) } else { index };
+            an.perm.fwd[k.min(n - 1)]
+        };
+        match self.variant {
+            CholeskyVariant::Llt => {
+                let req = sym.factorize_numeric_llt_scratch::<f64>(self.par, Spec::default());
+                let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
+                let r = sym.factorize_numeric_llt(
+                    &mut f.l_values,
+                    lower,
+                    Side::Lower,
+                    LltRegularization::default(),
+                    self.par,
+                    MemStack::new(&mut buf),
+                    Spec::default(),
+                );
+                if let Err(LltError::NonPositivePivot { index }) = r {
+                    return Err(pivot_error(first_pivot_index(index), 0.0));
+                }
+            }
+            CholeskyVariant::Ldlt => {
+                let req = sym.factorize_numeric_ldlt_scratch::<f64>(self.par, Spec::default());
+                let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
+                let r = sym.factorize_numeric_ldlt(
+                    &mut f.l_values,
+                    lower,
+                    Side::Lower,
+                    LdltRegularization::default(),
+                    self.par,
+                    MemStack::new(&mut buf),
+                    Spec::default(),
+                );
+                if let Err(e) = r {
+                    let faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } = e;
+                    return Err(pivot_error(first_pivot_index(index), 0.0));
+                }
+            }
+        }
+        // faer accepts tiny positive pivots: judge them relative to the (unit) scaled diagonal.
+        let diag = factor_diagonal(sym, &f.l_values);
+        for (k, d) in diag.iter().enumerate() {
+            let pivot = match self.variant {
+                CholeskyVariant::Llt => d * d,
+                CholeskyVariant::Ldlt => *d,
+            };
+            if !(pivot > self.pivot_tolerance) {
+                return Err(pivot_error(an.perm.fwd[k], pivot));
+            }
+        }
+        self.factor = Some(f);
+        Ok(())
+    }
+
+    fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError> {
+        let (an, f) = match (&self.analysis, &self.factor) {
+            (Some(a), Some(f)) => (a, f),
+            _ => return Err(SolverError::OutOfOrder("solve", "factorize")),
+        };
+        let n = an.n;
+        <dyn LinearSolver>::check_rhs(n, rhs, nrhs)?;
+        if n == 0 {
+            return Ok(SolveInfo::default());
+        }
+        for col in rhs.chunks_mut(n) {
+            col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
+        }
+        let req = an.symbolic.solve_in_place_scratch::<f64>(nrhs, self.par);
+        let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
+        let stack = MemStack::new(&mut buf);
+        let mat = MatMut::from_column_major_slice_mut(rhs, n, nrhs);
+        match self.variant {
+            CholeskyVariant::Llt => LltRef::new(&an.symbolic, &f.l_values)
+                .solve_in_place_with_conj(Conj::No, mat, self.par, stack),
+            CholeskyVariant::Ldlt => LdltRef::new(&an.symbolic, &f.l_values)
+                .solve_in_place_with_conj(Conj::No, mat, self.par, stack),
+        }
+        for col in rhs.chunks_mut(n) {
+            col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
+        }
+        Ok(SolveInfo::default())
+    }
+}

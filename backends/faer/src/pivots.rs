@@ -1,0 +1,50 @@
+//! Reading the pivots back out of a faer Cholesky factor, to catch (near-)zero pivots that
+//! faer accepts, and to count fill and flops.
+
+use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
+
+/// Entries per column of L (diagonal included), in factor (permuted) order.
+pub(crate) fn column_counts(symbolic: &SymbolicCholesky<usize>) -> Vec<usize> {
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr().windows(2).map(|w| w[1] - w[0]).collect(),
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let mut counts = Vec::with_capacity(s.ncols());
+            for k in 0..s.n_supernodes() {
+                let (b, e) = (s.supernode_begin()[k], s.supernode_end()[k]);
+                let below = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];
+                let rows = (e - b) + below;
+                counts.extend((0..e - b).map(|c| rows - c));
+            }
+            counts
+        }
+    }
+}
+
+/// nnz(L) and the flop count Σ c_j² of a left-looking Cholesky with column counts c_j.
+pub(crate) fn fill_and_flops(symbolic: &SymbolicCholesky<usize>) -> (usize, f64) {
+    let c = column_counts(symbolic);
+    (c.iter().sum(), c.iter().map(|&x| (x as f64) * (x as f64)).sum())
+}
+
+/// The diagonal entries of the factor values (L_jj for LLᵀ, D_j for LDLᵀ), in factor order.
+pub(crate) fn factor_diagonal(symbolic: &SymbolicCholesky<usize>, values: &[f64]) -> Vec<f64> {
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..s.ncols()].iter().map(|&p| values[p]).collect(),
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let mut d = Vec::with_capacity(s.ncols());
+            for k in 0..s.n_supernodes() {
+                let (b, e) = (s.supernode_begin()[k], s.supernode_end()[k]);
+                let below = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];
+                let rows = (e - b) + below;
+                let start = s.col_ptr_for_val()[k];
+                d.extend((0..e - b).map(|c| values[start + c * rows + c]));
+            }
+            d
+        }
+    }
+}
+
+/// Whether faer chose the simplicial variant (its pivot error index is then one-based).
+pub(crate) fn is_simplicial(symbolic: &SymbolicCholesky<usize>) -> bool {
+    matches!(symbolic.raw(), SymbolicCholeskyRaw::Simplicial(_))
+}
