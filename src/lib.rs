@@ -1,1 +1,32 @@
+//! # fibercell
+//!
+//! Effective mechanical properties of textiles from their fiber microstructure. A fabric cell
+//! is a network of 3D Euler–Bernoulli frame elements (thesis §4.2–4.3); this crate builds the
+//! model ([`model`]), the element matrices ([`element`]), the reduced sparse system
+//! ([`assembly`], [`constraints`]) and solves it through a pluggable sparse solver layer
+//! ([`fibercell_solver`], re-exported as [`solver`]) with faer, CG or CHOLMOD backends
+//! ([`solve`]). Files are handled in [`io`].
+//!
+//! The whole static analysis from Rust:
+//!
+//! ```no_run
+//! use fibercell::{io, solve};
+//! let model = io::load_model(std::path::Path::new("fixtures/ok_frame3d.toml"))?;
+//! let solution = solve::solve_static(&model, &solve::SolveOptions::default())?;
+//! println!("tip: {:?}", solution.displacements[0]);
+//! # Ok::<(), fibercell::Error>(())
+//! ```
+//!
+//! Units are SI throughout (m, N, Pa, rad). DOFs per node: ux, uy, uz, rx, ry, rz.
 
+pub mod assembly;
+pub mod constraints;
+pub mod element;
+mod error;
+pub mod io;
+pub mod model;
+pub mod solve;
+
+pub use error::Error;
+pub use fibercell_solver as solver;
+pub use model::Model;

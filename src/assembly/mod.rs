@@ -1,0 +1,12 @@
+//! From the model to the reduced sparse system: DOF numbering, the sparsity pattern with its
+//! slot map (built once), and the value fill (serial or parallel, refilled in place).
+
+mod coloring;
+mod dof_map;
+mod fill;
+mod pattern;
+
+pub use coloring::color_elements;
+pub use dof_map::DofMap;
+pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
+pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};

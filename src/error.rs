@@ -1,0 +1,56 @@
+//! The crate-wide error type.
+
+use crate::io::InputError;
+use crate::model::{Dof, ModelError};
+use fibercell_solver::SolverError;
+
+/// Everything fibercell can report; each variant names the offending item.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A model file could not be read or parsed.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// The model is invalid.
+    #[error("invalid model: {0}")]
+    Model(#[from] ModelError),
+    /// A group of connected fibers has no support at all.
+    #[error("fiber{} {} {} held by nothing: no support acts on the connected group they form, so the system is singular", if fibers.len() == 1 { "" } else { "s" }, list(fibers), if fibers.len() == 1 { "is" } else { "are" })]
+    Unsupported {
+        /// Ids of the fibers of that group.
+        fibers: Vec<u64>,
+    },
+    /// The stiffness is singular (a mechanism) at a DOF.
+    #[error("the stiffness is singular at node {node}, DOF {dof} (fiber{} {}): the structure can move there without resistance — a mechanism or a missing support (relative pivot {pivot:.2e})", if fibers.len() == 1 { "" } else { "s" }, list(fibers))]
+    Singular {
+        /// Node id.
+        node: u64,
+        /// DOF.
+        dof: Dof,
+        /// Fibers through that node.
+        fibers: Vec<u64>,
+        /// The pivot relative to its diagonal entry.
+        pivot: f64,
+    },
+    /// The sparse solver failed.
+    #[error("solver: {0}")]
+    Solver(#[from] SolverError),
+    /// The stiffness pattern does not fit the 32-bit slot map.
+    #[error(transparent)]
+    PatternTooLarge(#[from] crate::assembly::PatternTooLargeError),
+    /// Writing an output failed.
+    #[error("cannot write {path}: {message}")]
+    Output {
+        /// The file.
+        path: String,
+        /// Why.
+        message: String,
+    },
+}
+
+fn list(ids: &[u64]) -> String {
+    let mut s: Vec<String> = ids.iter().take(20).map(|i| i.to_string()).collect();
+    if ids.len() > 20 {
+        s.push(format!("… ({} in all)", ids.len()));
+    }
+    s.join(", ")
+}

@@ -1,0 +1,488 @@
+//! Abaqus `.inp` import of beam models.
+//!
+//! Supported: `*HEADING`, `*NODE`, `*ELEMENT, TYPE=B31|B33` (two-node beams, read as
+//! Euler–Bernoulli frame elements: B31's shear flexibility is neglected, which for slender fibers
+//! changes nothing measurable), `*NSET`/`*ELSET` (with `GENERATE`), `*BEAM SECTION,
+//! SECTION=CIRC` (radius on the data line, optional n1 direction line — irrelevant for a
+//! circular section), `*MATERIAL`/`*ELASTIC` (E, ν), `*STEP`/`*STATIC`/`*END STEP`,
+//! `*BOUNDARY` (node or set, first DOF, last DOF, value; or ENCASTRE/PINNED), `*CLOAD` (node or
+//! set, DOF, value), `**` comments, case-insensitive keywords. Any other keyword is an error
+//! naming it and its line. Elements of one section are chained into fibers (polylines), split
+//! where a node joins other than two of them.
+
+use super::InputError;
+use crate::model::{DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec};
+use std::collections::{BTreeMap, HashMap};
+
+struct Section {
+    elset: String,
+    material: String,
+    radius: Option<f64>,
+    line: usize,
+}
+
+#[derive(Default)]
+struct Reader {
+    path: String,
+    name: Option<String>,
+    nodes: Vec<NodeSpec>,
+    elements: Vec<(u64, u64, u64)>,
+    element_line: HashMap<u64, usize>,
+    nsets: HashMap<String, Vec<u64>>,
+    elsets: HashMap<String, Vec<u64>>,
+    sections: Vec<Section>,
+    materials: Vec<MaterialSpec>,
+    supports: Vec<SupportSpec>,
+    loads: Vec<LoadSpec>,
+    steps: usize,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Block {
+    None,
+    Heading,
+    Node,
+    Element,
+    Nset { generate: bool },
+    Elset { generate: bool },
+    BeamSection,
+    BeamSectionDirection,
+    Elastic,
+    Static,
+    Boundary,
+    Cload,
+}
+
+fn params(parts: &[&str]) -> HashMap<String, String> {
+    parts
+        .iter()
+        .filter_map(|p| {
+            let mut kv = p.splitn(2, '=');
+            let k = kv.next()?.trim().to_ascii_uppercase();
+            let v = kv.next().unwrap_or("").trim().to_string();
+            (!k.is_empty()).then_some((k, v))
+        })
+        .collect()
+}
+
+impl Reader {
+    fn err(&self, line: usize, message: impl Into<String>) -> InputError {
+        InputError::Syntax {
+            path: self.path.clone(),
+            line,
+            column: 1,
+            message: message.into(),
+        }
+    }
+
+    fn num(&self, line: usize, s: &str, what: &str) -> Result<f64, InputError> {
+        let v: f64 = s
+            .trim()
+            .replace(['d', 'D'], "e")
+            .parse()
+            .map_err(|_| self.err(line, format!("{what}: \"{}\" is not a number", s.trim())))?;
+        Ok(v)
+    }
+
+    fn id(&self, line: usize, s: &str, what: &str) -> Result<u64, InputError> {
+        s.trim()
+            .parse()
+            .map_err(|_| self.err(line, format!("{what}: \"{}\" is not a positive integer id", s.trim())))
+    }
+
+    fn dof(&self, line: usize, s: &str) -> Result<DofSet, InputError> {
+        let k = self.id(line, s, "DOF")?;
+        Ok(match k {
+            1 => DofSet::Ux,
+            2 => DofSet::Uy,
+            3 => DofSet::Uz,
+            4 => DofSet::Rx,
+            5 => DofSet::Ry,
+            6 => DofSet::Rz,
+            _ => return Err(self.err(line, format!("DOF {k} is not in 1..6"))),
+        })
+    }
+
+    /// A node id or the name of a node set.
+    fn node_targets(&self, line: usize, s: &str) -> Result<Vec<u64>, InputError> {
+        let s = s.trim();
+        if let Ok(id) = s.parse::<u64>() {
+            return Ok(vec![id]);
+        }
+        self.nsets
+            .get(&s.to_ascii_uppercase())
+            .cloned()
+            .ok_or_else(|| self.err(line, format!("unknown node or node set \"{s}\"")))
+    }
+
+    fn set_members(&self, line: usize, fields: &[&str], generate: bool) -> Result<Vec<u64>, InputError> {
+        let fields: Vec<&str> = fields.iter().copied().filter(|f| !f.trim().is_empty()).collect();
+        if generate {
+            if fields.len() < 2 || fields.len() > 3 {
+                return Err(self.err(line, "GENERATE needs first, last[, increment]"));
+            }
+            let a = self.id(line, fields[0], "first")?;
+            let b = self.id(line, fields[1], "last")?;
+            let inc = if fields.len() == 3 { self.id(line, fields[2], "increment")? } else { 1 };
+            if inc == 0 || b < a {
+                return Err(self.err(line, "GENERATE needs first ≤ last and a positive increment"));
+            }
+            return Ok((a..=b).step_by(inc as usize).collect());
+        }
+        fields.iter().map(|f| self.id(line, f, "set member")).collect()
+    }
+
+    fn data_line(&mut self, block: Block, line: usize, fields: &[&str], ctx: &mut Context) -> Result<Block, InputError> {
+        let need = |n: usize, what: &str| -> Result<(), InputError> {
+            if fields.iter().filter(|f| !f.trim().is_empty()).count() < n {
+                Err(self.err(line, format!("{what} needs at least {n} values")))
+            } else {
+                Ok(())
+            }
+        };
+        match block {
+            Block::None => return Err(self.err(line, "data line outside any keyword block")),
+            Block::Heading => {
+                if self.name.is_none() {
+                    self.name = Some(fields.join(",").trim().to_string());
+                }
+            }
+            Block::Node => {
+                need(3, "*NODE")?;
+                let id = self.id(line, fields[0], "node id")?;
+                let mut x = [0.0; 3];
+                for k in 0..3 {
+                    if let Some(f) = fields.get(k + 1).filter(|f| !f.trim().is_empty()) {
+                        x[k] = self.num(line, f, "coordinate")?;
+                    }
+                }
+                self.nodes.push(NodeSpec { id, x });
+                if let Some(set) = &ctx.nset {
+                    self.nsets.entry(set.clone()).or_default().push(id);
+                }
+            }
+            Block::Element => {
+                let f: Vec<&str> = fields.iter().copied().filter(|f| !f.trim().is_empty()).collect();
+                if f.len() != 3 {
+                    return Err(self.err(line, format!("two-node beam element needs id, node, node; found {} values", f.len())));
+                }
+                let id = self.id(line, f[0], "element id")?;
+                let a = self.id(line, f[1], "node")?;
+                let b = self.id(line, f[2], "node")?;
+                if let Some(first) = self.element_line.insert(id, line) {
+                    return Err(self.err(line, format!("element {id} already defined on line {first}")));
+                }
+                self.elements.push((id, a, b));
+                if let Some(set) = &ctx.elset {
+                    self.elsets.entry(set.clone()).or_default().push(id);
+                }
+            }
+            Block::Nset { generate } => {
+                let m = self.set_members(line, fields, generate)?;
+                if let Some(set) = &ctx.nset {
+                    self.nsets.entry(set.clone()).or_default().extend(m);
+                }
+            }
+            Block::Elset { generate } => {
+                let m = self.set_members(line, fields, generate)?;
+                if let Some(set) = &ctx.elset {
+                    self.elsets.entry(set.clone()).or_default().extend(m);
+                }
+            }
+            Block::BeamSection => {
+                need(1, "*BEAM SECTION, SECTION=CIRC")?;
+                let r = self.num(line, fields[0], "radius")?;
+                if let Some(s) = self.sections.last_mut() {
+                    s.radius = Some(r);
+                }
+                return Ok(Block::BeamSectionDirection);
+            }
+            Block::BeamSectionDirection => {
+                // n1 direction: checked, then irrelevant for a circular section.
+                need(3, "beam section direction")?;
+                for f in &fields[..3] {
+                    self.num(line, f, "direction")?;
+                }
+                return Ok(Block::None);
+            }
+            Block::Elastic => {
+                need(2, "*ELASTIC")?;
+                let e = self.num(line, fields[0], "E")?;
+                let nu = self.num(line, fields[1], "ν")?;
+                let name = ctx.material.clone().ok_or_else(|| self.err(line, "*ELASTIC outside a *MATERIAL"))?;
+                self.materials.push(MaterialSpec {
+                    name,
+                    young: e,
+                    poisson: Some(nu),
+                    shear: None,
+                });
+                return Ok(Block::None);
+            }
+            Block::Static => {}
+            Block::Boundary => {
+                need(2, "*BOUNDARY")?;
+                let targets = self.node_targets(line, fields[0])?;
+                let second = fields[1].trim().to_ascii_uppercase();
+                let (dofs, value) = match second.as_str() {
+                    "ENCASTRE" => (vec![DofSet::All], 0.0),
+                    "PINNED" => (vec![DofSet::Translations], 0.0),
+                    _ => {
+                        let first = self.dof(line, fields[1])?;
+                        let last = match fields.get(2).filter(|f| !f.trim().is_empty()) {
+                            Some(f) => self.dof(line, f)?,
+                            None => first,
+                        };
+                        let (a, b) = (first.dofs()[0].index(), last.dofs()[0].index());
+                        if b < a {
+                            return Err(self.err(line, "last DOF before first DOF"));
+                        }
+                        let value = match fields.get(3).filter(|f| !f.trim().is_empty()) {
+                            Some(f) => self.num(line, f, "prescribed value")?,
+                            None => 0.0,
+                        };
+                        let sets = [DofSet::Ux, DofSet::Uy, DofSet::Uz, DofSet::Rx, DofSet::Ry, DofSet::Rz];
+                        (sets[a..=b].to_vec(), value)
+                    }
+                };
+                for node in targets {
+                    self.supports.push(SupportSpec { node, dofs: dofs.clone(), value });
+                }
+            }
+            Block::Cload => {
+                need(3, "*CLOAD")?;
+                let targets = self.node_targets(line, fields[0])?;
+                let k = self.dof(line, fields[1])?.dofs()[0].index();
+                let v = self.num(line, fields[2], "load")?;
+                for node in targets {
+                    let mut l = LoadSpec { node, force: [0.0; 3], moment: [0.0; 3] };
+                    if k < 3 {
+                        l.force[k] = v;
+                    } else {
+                        l.moment[k - 3] = v;
+                    }
+                    self.loads.push(l);
+                }
+            }
+        }
+        Ok(block)
+    }
+
+    fn keyword(&mut self, line: usize, text: &str, ctx: &mut Context) -> Result<Block, InputError> {
+        let parts: Vec<&str> = text[1..].split(',').collect();
+        let kw = parts[0].trim().to_ascii_uppercase();
+        let p = params(&parts[1..]);
+        let unsupported = || InputError::UnsupportedKeyword {
+            path: self.path.clone(),
+            line,
+            keyword: parts[0].trim().to_string(),
+        };
+        let generate = p.contains_key("GENERATE");
+        Ok(match kw.as_str() {
+            "HEADING" => Block::Heading,
+            "NODE" => {
+                ctx.nset = p.get("NSET").map(|s| s.to_ascii_uppercase());
+                Block::Node
+            }
+            "ELEMENT" => {
+                let ty = p.get("TYPE").map(|t| t.to_ascii_uppercase()).unwrap_or_default();
+                if ty != "B31" && ty != "B33" {
+                    return Err(self.err(line, format!("element TYPE={ty} is not supported (only B31 and B33 two-node beams)")));
+                }
+                ctx.elset = p.get("ELSET").map(|s| s.to_ascii_uppercase());
+                Block::Element
+            }
+            "NSET" => {
+                ctx.nset = Some(p.get("NSET").ok_or_else(|| self.err(line, "*NSET needs NSET="))?.to_ascii_uppercase());
+                Block::Nset { generate }
+            }
+            "ELSET" => {
+                ctx.elset = Some(p.get("ELSET").ok_or_else(|| self.err(line, "*ELSET needs ELSET="))?.to_ascii_uppercase());
+                Block::Elset { generate }
+            }
+            "BEAM SECTION" => {
+                let sec = p.get("SECTION").map(|s| s.to_ascii_uppercase()).unwrap_or_default();
+                if sec != "CIRC" {
+                    return Err(self.err(line, format!("*BEAM SECTION, SECTION={sec} is not supported (only CIRC)")));
+                }
+                let elset = p.get("ELSET").ok_or_else(|| self.err(line, "*BEAM SECTION needs ELSET="))?;
+                let material = p.get("MATERIAL").ok_or_else(|| self.err(line, "*BEAM SECTION needs MATERIAL="))?;
+                self.sections.push(Section {
+                    elset: elset.to_ascii_uppercase(),
+                    material: material.to_ascii_uppercase(),
+                    radius: None,
+                    line,
+                });
+                Block::BeamSection
+            }
+            "MATERIAL" => {
+                ctx.material = Some(p.get("NAME").ok_or_else(|| self.err(line, "*MATERIAL needs NAME="))?.to_ascii_uppercase());
+                Block::None
+            }
+            "ELASTIC" => {
+                if let Some(t) = p.get("TYPE") {
+                    if !t.eq_ignore_ascii_case("ISOTROPIC") {
+                        return Err(self.err(line, format!("*ELASTIC, TYPE={t} is not supported (only ISOTROPIC)")));
+                    }
+                }
+                Block::Elastic
+            }
+            "STEP" => {
+                self.steps += 1;
+                if self.steps > 1 {
+                    return Err(self.err(line, "only one *STEP is supported"));
+                }
+                Block::None
+            }
+            "STATIC" => Block::Static,
+            "END STEP" => Block::None,
+            "BOUNDARY" => {
+                if p.contains_key("TYPE") || p.contains_key("OP") {
+                    return Err(self.err(line, "*BOUNDARY options TYPE= and OP= are not supported"));
+                }
+                Block::Boundary
+            }
+            "CLOAD" => {
+                if p.contains_key("OP") {
+                    return Err(self.err(line, "*CLOAD, OP= is not supported"));
+                }
+                Block::Cload
+            }
+            _ => return Err(unsupported()),
+        })
+    }
+}
+
+#[derive(Default)]
+struct Context {
+    nset: Option<String>,
+    elset: Option<String>,
+    material: Option<String>,
+}
+
+/// Splits the elements of one section into polylines: chains through nodes that join exactly
+/// two of them. Returns node-id lists with the id of each chain's first element.
+fn chain(elements: &[(u64, u64, u64)]) -> Vec<(u64, Vec<u64>)> {
+    let mut at: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
+    for (k, &(_, a, b)) in elements.iter().enumerate() {
+        at.entry(a).or_default().push(k);
+        at.entry(b).or_default().push(k);
+    }
+    let mut used = vec![false; elements.len()];
+    let mut out = Vec::new();
+    let walk = |start_el: usize, start_node: u64, used: &mut Vec<bool>| {
+        let mut nodes = vec![start_node];
+        let mut el = start_el;
+        let mut node = start_node;
+        loop {
+            used[el] = true;
+            let (_, a, b) = elements[el];
+            node = if a == node { b } else { a };
+            nodes.push(node);
+            let next = match at.get(&node) {
+                Some(v) if v.len() == 2 => v.iter().copied().find(|&k| !used[k]),
+                _ => None,
+            };
+            match next {
+                Some(k) => el = k,
+                None => break,
+            }
+        }
+        nodes
+    };
+    // Open chains start at ends and junctions, in element order; what remains are closed loops.
+    for k in 0..elements.len() {
+        if used[k] {
+            continue;
+        }
+        let (id, a, b) = elements[k];
+        let end = [a, b].into_iter().find(|n| at.get(n).is_some_and(|v| v.len() != 2));
+        if let Some(start) = end {
+            out.push((id, walk(k, start, &mut used)));
+        }
+    }
+    for k in 0..elements.len() {
+        if !used[k] {
+            let (id, a, _) = elements[k];
+            out.push((id, walk(k, a, &mut used)));
+        }
+    }
+    out
+}
+
+/// Parses an Abaqus input file into a model description.
+pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputError> {
+    let mut r = Reader {
+        path: path.to_string(),
+        ..Reader::default()
+    };
+    let mut ctx = Context::default();
+    let mut block = Block::None;
+    for (k, raw) in text.lines().enumerate() {
+        let line = k + 1;
+        let t = raw.trim();
+        if t.is_empty() || t.starts_with("**") {
+            continue;
+        }
+        if t.starts_with('*') {
+            block = r.keyword(line, t, &mut ctx)?;
+        } else {
+            let fields: Vec<&str> = t.trim_end_matches(',').split(',').collect();
+            block = r.data_line(block, line, &fields, &mut ctx)?;
+        }
+    }
+    let path_err = |line: usize, m: String| InputError::Syntax { path: path.into(), line, column: 1, message: m };
+    // Sections → fibers.
+    let by_id: HashMap<u64, (u64, u64, u64)> = r.elements.iter().map(|e| (e.0, *e)).collect();
+    let mut owner: HashMap<u64, usize> = HashMap::new();
+    let mut fibers = Vec::new();
+    let materials: HashMap<String, ()> = r.materials.iter().map(|m| (m.name.clone(), ())).collect();
+    for (si, s) in r.sections.iter().enumerate() {
+        let radius = s.radius.ok_or_else(|| path_err(s.line, "*BEAM SECTION has no data line with the radius".into()))?;
+        if !materials.contains_key(&s.material) {
+            return Err(path_err(s.line, format!("*BEAM SECTION refers to unknown material {}", s.material)));
+        }
+        let members = r.elsets.get(&s.elset).ok_or_else(|| path_err(s.line, format!("unknown element set {}", s.elset)))?;
+        let mut els = Vec::with_capacity(members.len());
+        for id in members {
+            let e = by_id.get(id).ok_or_else(|| path_err(s.line, format!("element set {} contains unknown element {id}", s.elset)))?;
+            if let Some(prev) = owner.insert(*id, si) {
+                if prev != si {
+                    return Err(path_err(s.line, format!("element {id} has two beam sections")));
+                }
+                continue;
+            }
+            els.push(*e);
+        }
+        for (id, nodes) in chain(&els) {
+            fibers.push(FiberSpec { id, nodes, radius, material: s.material.clone() });
+        }
+    }
+    if let Some(&(id, _, _)) = r.elements.iter().find(|e| !owner.contains_key(&e.0)) {
+        return Err(path_err(r.element_line[&id], format!("element {id} has no *BEAM SECTION")));
+    }
+    Ok(ModelDescription {
+        name: r.name,
+        materials: r.materials,
+        nodes: r.nodes,
+        fibers,
+        supports: r.supports,
+        loads: r.loads,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chains_split_at_junctions_and_close_loops() {
+        // 1-2-3 and 3-4 and 3-5 (junction at 3), plus a triangle loop 10-11-12.
+        let els = [(1, 1, 2), (2, 2, 3), (3, 3, 4), (4, 5, 3), (5, 10, 11), (6, 11, 12), (7, 12, 10)];
+        let c = chain(&els);
+        assert_eq!(c[0], (1, vec![1, 2, 3]));
+        assert_eq!(c[1], (3, vec![3, 4]));
+        assert_eq!(c[2], (4, vec![5, 3]));
+        assert_eq!(c[3], (5, vec![10, 11, 12, 10]));
+        assert_eq!(c.len(), 4);
+    }
+}

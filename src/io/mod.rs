@@ -1,0 +1,49 @@
+//! Files: the native model format (TOML and JSON, one schema), Abaqus `.inp` import, results
+//! (CSV, JSON), VTK `.vtu` and Matrix Market output. Outputs are written atomically.
+
+mod abaqus;
+mod atomic;
+mod error;
+mod matrix_market;
+mod native;
+mod results;
+mod vtk;
+
+pub use abaqus::parse_abaqus;
+pub use atomic::write_atomic;
+pub use error::InputError;
+pub use matrix_market::write_matrix_market;
+pub use native::{parse_json, parse_toml, to_json, to_toml};
+pub use results::{displacements_csv, solution_json};
+pub use vtk::deformed_vtu;
+
+use crate::model::{Model, ModelDescription};
+use crate::Error;
+use std::path::Path;
+
+/// Reads a model file, choosing the format by extension (`.toml`, `.json`, `.inp`), and
+/// validates it.
+pub fn load_model(path: &Path) -> Result<Model, Error> {
+    let desc = read_description(path)?;
+    Ok(Model::from_description(&desc)?)
+}
+
+/// Reads a model file into its unvalidated description.
+pub fn read_description(path: &Path) -> Result<ModelDescription, Error> {
+    let shown = path.display().to_string();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    let parse: fn(&str, &str) -> Result<ModelDescription, InputError> = match ext.as_deref() {
+        Some("toml") => parse_toml,
+        Some("json") => parse_json,
+        Some("inp") => parse_abaqus,
+        _ => return Err(InputError::UnknownFormat { path: shown }.into()),
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| InputError::Read {
+        path: shown.clone(),
+        message: e.to_string(),
+    })?;
+    Ok(parse(&text, &shown)?)
+}
