@@ -1,0 +1,152 @@
+//! Helpers shared by the integration tests: small model builders.
+#![allow(dead_code)]
+
+use fibercell::model::{DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec};
+use fibercell::Model;
+
+pub const E: f64 = 2.1e11;
+pub const NU: f64 = 0.3;
+
+pub fn steel() -> MaterialSpec {
+    MaterialSpec {
+        name: "steel".into(),
+        young: E,
+        poisson: Some(NU),
+        shear: None,
+    }
+}
+
+/// A straight fiber from `a` to `b` in `n` elements, clamped at `a`, with a tip force and
+/// moment at `b`. Node ids 1..=n+1 from a to b.
+pub fn cantilever(a: [f64; 3], b: [f64; 3], n: usize, radius: f64, force: [f64; 3], moment: [f64; 3]) -> ModelDescription {
+    let nodes: Vec<NodeSpec> = (0..=n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            NodeSpec {
+                id: k as u64 + 1,
+                x: [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])],
+            }
+        })
+        .collect();
+    ModelDescription {
+        name: Some("cantilever".into()),
+        materials: vec![steel()],
+        fibers: vec![FiberSpec {
+            id: 1,
+            nodes: nodes.iter().map(|n| n.id).collect(),
+            radius,
+            material: "steel".into(),
+        }],
+        nodes,
+        supports: vec![SupportSpec {
+            node: 1,
+            dofs: vec![DofSet::All],
+            value: 0.0,
+        }],
+        loads: vec![LoadSpec {
+            node: n as u64 + 1,
+            force,
+            moment,
+        }],
+    }
+}
+
+/// A square grid of `k`×`k` straight fibers (k along x, k along y) joined at their crossings,
+/// each edge split in `sub` elements, clamped along the x = 0 edge, loaded at the far corner.
+pub fn grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDescription {
+    let m = (k - 1) * sub + 1; // nodes per fiber
+    let id = |i: usize, j: usize| (i * m + j) as u64 + 1; // grid point (i along x, j along y)
+    let h = spacing / sub as f64;
+    let mut nodes = Vec::new();
+    for i in 0..m {
+        for j in 0..m {
+            // Only points on a fiber: i or j at a crossing line.
+            if i % sub == 0 || j % sub == 0 {
+                nodes.push(NodeSpec {
+                    id: id(i, j),
+                    x: [i as f64 * h, j as f64 * h, 0.01 * ((i * 7 + j * 3) % 5) as f64 * h],
+                });
+            }
+        }
+    }
+    let mut fibers = Vec::new();
+    for f in 0..k {
+        fibers.push(FiberSpec {
+            id: f as u64 + 1,
+            nodes: (0..m).map(|j| id(f * sub, j)).collect(),
+            radius,
+            material: "steel".into(),
+        });
+        fibers.push(FiberSpec {
+            id: (k + f) as u64 + 1,
+            nodes: (0..m).map(|i| id(i, f * sub)).collect(),
+            radius,
+            material: "steel".into(),
+        });
+    }
+    let supports = (0..m)
+        .map(|j| SupportSpec {
+            node: id(0, j),
+            dofs: vec![DofSet::All],
+            value: 0.0,
+        })
+        .collect();
+    ModelDescription {
+        name: Some("grid".into()),
+        materials: vec![steel()],
+        nodes,
+        fibers,
+        supports,
+        loads: vec![LoadSpec {
+            node: id(m - 1, m - 1),
+            force: [10.0, -20.0, 5.0],
+            moment: [0.1, 0.2, -0.3],
+        }],
+    }
+}
+
+pub fn build(d: &ModelDescription) -> Model {
+    Model::from_description(d).expect("valid test model")
+}
+
+/// Relative difference |a − b| / max(|b|, floor).
+pub fn rel(a: f64, b: f64, floor: f64) -> f64 {
+    (a - b).abs() / b.abs().max(floor)
+}
+
+/// Thesis (4.25), (4.26) with H₂ corrected, second derivatives, written out independently of
+/// the library.
+fn d2_hermite(s: f64, l: f64) -> [f64; 4] {
+    [
+        (-6.0 * l + 12.0 * s) / l.powi(3),
+        (-4.0 * l + 6.0 * s) / (l * l),
+        (6.0 * l - 12.0 * s) / l.powi(3),
+        (-2.0 * l + 6.0 * s) / (l * l),
+    ]
+}
+
+/// k = ∫ Bᵀ D B ds (4.34) by 3-point Gauss–Legendre quadrature (exact for these quadratic
+/// integrands), local DOF order u v w θx θy θz per node, θz = v′, θy = −w′.
+pub fn quadrature_local_stiffness(ea: f64, ei2: f64, ei3: f64, gj: f64, l: f64) -> nalgebra::DMatrix<f64> {
+    use nalgebra::{DMatrix, DVector};
+    let gauss = [(-(0.6f64).sqrt(), 5.0 / 9.0), (0.0, 8.0 / 9.0), ((0.6f64).sqrt(), 5.0 / 9.0)];
+    let d = DMatrix::from_diagonal(&DVector::from_vec(vec![ea, ei3, ei2, gj]));
+    let mut k = DMatrix::<f64>::zeros(12, 12);
+    for (xi, w) in gauss {
+        let s = 0.5 * l * (xi + 1.0);
+        let mut b = DMatrix::<f64>::zeros(4, 12);
+        b[(0, 0)] = -1.0 / l;
+        b[(0, 6)] = 1.0 / l;
+        b[(3, 3)] = -1.0 / l;
+        b[(3, 9)] = 1.0 / l;
+        let h = d2_hermite(s, l);
+        for (dof, hk) in [(1, h[0]), (5, h[1]), (7, h[2]), (11, h[3])] {
+            b[(1, dof)] = hk;
+        }
+        for (dof, hk) in [(2, h[0]), (4, -h[1]), (8, h[2]), (10, -h[3])] {
+            b[(2, dof)] = hk;
+        }
+        k += b.transpose() * &d * b * (0.5 * l * w);
+    }
+    k
+}
