@@ -1,0 +1,300 @@
+//! The solver layer on its own and through the mechanics: every backend and ordering agrees on
+//! the same systems (≤ 1e-8), sprs matrices are accepted, symbolic analysis is reused, and each
+//! failure is a typed error.
+
+mod common;
+use common::*;
+use fibercell::solve::{make_solver, solve_static, ReducedSystem, SolveOptions, SolverKind};
+use fibercell::solver::{solve_checked, CscMatrix, CscRef, LinearSolver, Ordering, SolverError, StopReason};
+use fibercell::{io, Error};
+use fibercell_cg::ConjugateGradient;
+use fibercell_faer::{CholeskyVariant, FaerCholesky, FaerLu};
+use std::path::Path;
+
+fn direct_solvers() -> Vec<(String, Box<dyn LinearSolver>)> {
+    let mut v: Vec<(String, Box<dyn LinearSolver>)> = Vec::new();
+    for o in [Ordering::Auto, Ordering::Natural, Ordering::Amd, Ordering::NestedDissection] {
+        for var in [CholeskyVariant::Llt, CholeskyVariant::Ldlt] {
+            v.push((format!("faer {var:?} {}", o.name()), Box::new(FaerCholesky::new(var, o.clone()))));
+        }
+        #[cfg(feature = "cholmod")]
+        v.push((format!("cholmod {}", o.name()), Box::new(fibercell_cholmod::Cholmod::new(o.clone()))));
+    }
+    v.push(("faer lu".into(), Box::new(FaerLu::new())));
+    v.push(("cg".into(), Box::new(ConjugateGradient::new())));
+    v
+}
+
+fn systems() -> Vec<(String, ReducedSystem)> {
+    let frame = io::load_model(Path::new("fixtures/ok_frame3d.toml")).unwrap();
+    let grid = build(&grid(8, 3, 0.01, 3e-4));
+    vec![
+        ("frame".into(), ReducedSystem::assemble(&frame, Default::default()).unwrap()),
+        ("grid".into(), ReducedSystem::assemble(&grid, Default::default()).unwrap()),
+    ]
+}
+
+fn reference(a: CscRef<'_>, b: &[f64]) -> Vec<f64> {
+    let mut s = FaerCholesky::default();
+    s.analyze(a).unwrap();
+    s.factorize(a).unwrap();
+    solve_checked(&mut s, a, b, 1).unwrap().0
+}
+
+#[test]
+fn every_backend_and_ordering_agrees() {
+    for (name, sys) in systems() {
+        let a = sys.matrix().unwrap();
+        let want = reference(a, &sys.rhs);
+        let scale = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let mut solvers = direct_solvers();
+        let p = fibercell::solver::compute_ordering(a, &Ordering::NestedDissection).unwrap();
+        solvers.push(("faer given".into(), Box::new(FaerCholesky::new(CholeskyVariant::Llt, Ordering::Given(p.fwd)))));
+        solvers.push((
+            "cg node blocks".into(),
+            Box::new(ConjugateGradient::new().with_blocks(sys.dofs.node_block_starts())),
+        ));
+        for (sname, mut s) in solvers {
+            s.analyze(a).unwrap_or_else(|e| panic!("{sname} on {name}: {e}"));
+            s.factorize(a).unwrap_or_else(|e| panic!("{sname} on {name}: {e}"));
+            let (x, report) = solve_checked(s.as_mut(), a, &sys.rhs, 1).unwrap();
+            assert!(report.relative_residual < 1e-9, "{sname} on {name}: residual {}", report.relative_residual);
+            for (p, q) in x.iter().zip(&want) {
+                assert!((p - q).abs() <= 1e-8 * scale, "{sname} on {name}: {p} vs {q}");
+            }
+        }
+    }
+}
+
+#[test]
+fn every_backend_through_the_mechanics() {
+    let m = io::load_model(Path::new("fixtures/ok_frame3d.toml")).unwrap();
+    let want = solve_static(&m, &SolveOptions::default()).unwrap().displacements;
+    for kind in SolverKind::ALL {
+        let opts = SolveOptions { solver: kind, ..SolveOptions::default() };
+        match solve_static(&m, &opts) {
+            Ok(sol) => {
+                assert!(kind.is_available());
+                assert!(sol.summary.relative_residual < 1e-9);
+                for (u, w) in sol.displacements.iter().zip(&want) {
+                    for k in 0..6 {
+                        assert!((u[k] - w[k]).abs() <= 1e-8 * 0.02, "{kind}");
+                    }
+                }
+            }
+            Err(Error::Solver(SolverError::Unavailable { backend, .. })) => {
+                assert!(!kind.is_available());
+                assert_eq!(backend, "cholmod");
+            }
+            Err(e) => panic!("{kind}: {e}"),
+        }
+    }
+}
+
+#[test]
+fn sprs_matrices_are_accepted_without_fibercell() {
+    let sys = &systems()[1].1;
+    let a = sys.matrix().unwrap();
+    let want = reference(a, &sys.rhs);
+    let sp = a.to_owned().to_sprs();
+    // Borrowed, zero-copy (CSC) …
+    let view = sp.view();
+    let borrowed = CscRef::try_from_sprs(&view).unwrap();
+    // … and copied from CSR.
+    let from_csr = CscMatrix::from_sprs(sp.to_csr().view()).unwrap();
+    for m in [borrowed, from_csr.as_ref()] {
+        let mut s = FaerCholesky::default();
+        s.analyze(m).unwrap();
+        s.factorize(m).unwrap();
+        let (x, _) = solve_checked(&mut s, m, &sys.rhs, 1).unwrap();
+        for (p, q) in x.iter().zip(&want) {
+            assert!((p - q).abs() <= 1e-12 * q.abs().max(1e-9));
+        }
+    }
+}
+
+#[test]
+fn symbolic_analysis_is_reused_and_many_rhs_solve_at_once() {
+    let sys = &systems()[1].1;
+    let a = sys.matrix().unwrap();
+    let n = a.ncols();
+    let mut s = FaerCholesky::default();
+    s.analyze(a).unwrap();
+    s.factorize(a).unwrap();
+    let x1 = solve_checked(&mut s, a, &sys.rhs, 1).unwrap().0;
+    // Same pattern, doubled values: refactorize without analyze, solution halves.
+    let doubled: Vec<f64> = a.values().iter().map(|v| 2.0 * v).collect();
+    let a2 = CscRef::new(n, n, a.col_ptr(), a.row_idx(), &doubled).unwrap();
+    s.factorize(a2).unwrap();
+    let mut b3 = Vec::new();
+    for k in 1..=3 {
+        b3.extend(sys.rhs.iter().map(|v| v * k as f64));
+    }
+    let (x3, report) = solve_checked(&mut s, a2, &b3, 3).unwrap();
+    assert!(report.relative_residual < 1e-10);
+    let scale = x1.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for k in 1..=3 {
+        for i in 0..n {
+            let want = x1[i] * k as f64 / 2.0;
+            assert!((x3[(k - 1) * n + i] - want).abs() <= 1e-10 * scale * k as f64);
+        }
+    }
+    // A different pattern is refused until analyze runs again.
+    let other = CscMatrix::from_triplets(n, n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>()).unwrap();
+    assert_eq!(s.factorize(other.as_ref()), Err(SolverError::PatternChanged));
+    let mut fresh = FaerCholesky::default();
+    assert!(matches!(fresh.factorize(a), Err(SolverError::OutOfOrder(..))));
+    assert!(matches!(fresh.solve_in_place(&mut vec![0.0; n], 1), Err(SolverError::OutOfOrder(..))));
+}
+
+fn block_diag_with_singular_block(blocks: usize, size: usize, bad: usize) -> CscMatrix {
+    let mut t = Vec::new();
+    for b in 0..blocks {
+        for i in 0..size {
+            for j in 0..size {
+                let (gi, gj) = (b * size + i, b * size + j);
+                let v = if b == bad {
+                    // Rank one: v vᵀ with v = (1, 2, …): positive diagonal, singular.
+                    ((i + 1) * (j + 1)) as f64
+                } else if i == j {
+                    size as f64 + 1.0
+                } else {
+                    1.0 / (1.0 + (i as f64 - j as f64).abs())
+                };
+                t.push((gi, gj, v));
+            }
+        }
+    }
+    CscMatrix::from_triplets(blocks * size, blocks * size, &t).unwrap()
+}
+
+#[test]
+fn not_positive_definite_is_reported_at_the_right_column() {
+    // Diagonal with one negative entry: column 2, whatever the ordering.
+    let a = CscMatrix::from_triplets(4, 4, &[(0, 0, 1.0), (1, 1, 2.0), (2, 2, -3.0), (3, 3, 4.0)]).unwrap();
+    let mut solvers: Vec<Box<dyn LinearSolver>> = vec![
+        Box::new(FaerCholesky::new(CholeskyVariant::Llt, Ordering::Natural)),
+        Box::new(FaerCholesky::new(CholeskyVariant::Ldlt, Ordering::Amd)),
+    ];
+    #[cfg(feature = "cholmod")]
+    solvers.push(Box::new(fibercell_cholmod::Cholmod::new(Ordering::Natural)));
+    for mut s in solvers {
+        s.analyze(a.as_ref()).unwrap();
+        match s.factorize(a.as_ref()) {
+            Err(SolverError::NotPositiveDefinite { column, .. }) => assert_eq!(column, 2, "{}", s.name()),
+            other => panic!("{}: {other:?}", s.name()),
+        }
+    }
+    // A singular block inside larger dense blocks (simplicial and supernodal factorizations):
+    // the column reported lies in the singular block.
+    for (blocks, size) in [(3, 4), (6, 40)] {
+        let bad = blocks / 2;
+        let a = block_diag_with_singular_block(blocks, size, bad);
+        for o in [Ordering::Natural, Ordering::Amd] {
+            for var in [CholeskyVariant::Llt, CholeskyVariant::Ldlt] {
+                let mut s = FaerCholesky::new(var, o.clone());
+                s.analyze(a.as_ref()).unwrap();
+                match s.factorize(a.as_ref()) {
+                    Err(SolverError::NotPositiveDefinite { column, pivot }) => {
+                        assert!((bad * size..(bad + 1) * size).contains(&column), "{var:?} {o:?}: column {column}");
+                        assert!(pivot < 1e-12);
+                    }
+                    other => panic!("{var:?} {o:?}: {other:?}"),
+                }
+            }
+        }
+        #[cfg(feature = "cholmod")]
+        {
+            let mut s = fibercell_cholmod::Cholmod::new(Ordering::Auto);
+            s.analyze(a.as_ref()).unwrap();
+            assert!(matches!(
+                s.factorize(a.as_ref()),
+                Err(SolverError::NotPositiveDefinite { .. } | SolverError::Singular { .. })
+            ));
+        }
+    }
+}
+
+#[test]
+fn lu_solves_nonsymmetric_systems_and_flags_zero_pivots() {
+    // Nonsymmetric 3×3 with known solution x = (1, −2, 3).
+    let a = CscMatrix::from_triplets(
+        3,
+        3,
+        &[(0, 0, 4.0), (0, 1, 1.0), (1, 0, -2.0), (1, 1, 5.0), (1, 2, 1.0), (2, 1, 3.0), (2, 2, 6.0), (0, 2, 0.5)],
+    )
+    .unwrap();
+    let x = [1.0, -2.0, 3.0];
+    let mut b = vec![0.0; 3];
+    a.as_ref().mul_vec(&x, &mut b);
+    let mut lu = FaerLu::new();
+    assert!(!lu.capabilities().symmetric_only);
+    lu.analyze(a.as_ref()).unwrap();
+    lu.factorize(a.as_ref()).unwrap();
+    let (got, report) = solve_checked(&mut lu, a.as_ref(), &b, 1).unwrap();
+    assert!(report.relative_residual < 1e-14);
+    for k in 0..3 {
+        assert!((got[k] - x[k]).abs() < 1e-13);
+    }
+    // Numerically singular (row 2 = 2 · row 1): an error, not a solution.
+    let s = CscMatrix::from_triplets(3, 3, &[(0, 0, 1.0), (0, 1, 2.0), (1, 0, 2.0), (1, 1, 4.0), (2, 2, 1.0)]).unwrap();
+    let mut lu = FaerLu::new();
+    lu.analyze(s.as_ref()).unwrap();
+    assert!(matches!(lu.factorize(s.as_ref()), Err(SolverError::Singular { .. })));
+}
+
+#[test]
+fn cg_reports_iterations_and_why_it_stopped() {
+    let sys = &systems()[1].1;
+    let a = sys.matrix().unwrap();
+    let mut cg = ConjugateGradient::new().with_blocks(sys.dofs.node_block_starts());
+    cg.analyze(a).unwrap();
+    cg.factorize(a).unwrap();
+    let (_, report) = solve_checked(&mut cg, a, &sys.rhs, 1).unwrap();
+    assert_eq!(report.info.stop, Some(StopReason::Converged));
+    assert!(report.info.iterations.unwrap() > 0);
+    assert!(report.info.residual_estimate.unwrap() <= 1e-12);
+    let mut short = ConjugateGradient::new().with_max_iterations(3);
+    short.analyze(a).unwrap();
+    short.factorize(a).unwrap();
+    match short.solve_in_place(&mut sys.rhs.clone(), 1) {
+        Err(SolverError::NoConvergence { iterations, residual, reason, .. }) => {
+            assert_eq!(iterations, 3);
+            assert!(residual > 0.0 && residual.is_finite());
+            assert_eq!(reason, StopReason::MaxIterations);
+        }
+        other => panic!("{other:?}"),
+    }
+    // Indefinite with positive diagonal blocks: CG breaks down.
+    let ind = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (0, 1, 2.0), (1, 0, 2.0), (1, 1, 1.0)]).unwrap();
+    let mut cg = ConjugateGradient::new().with_block_size(1);
+    cg.analyze(ind.as_ref()).unwrap();
+    cg.factorize(ind.as_ref()).unwrap();
+    match cg.solve_in_place(&mut vec![1.0, -1.0], 1) {
+        Err(SolverError::NoConvergence { reason: StopReason::Breakdown, .. }) => {}
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn non_finite_inputs_are_errors() {
+    let a = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (1, 1, f64::NAN)]).unwrap();
+    let mut s = FaerCholesky::default();
+    assert!(matches!(s.analyze(a.as_ref()), Err(SolverError::NonFinite { what: "matrix", index: 1 })));
+    let a = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (1, 1, 1.0)]).unwrap();
+    s.analyze(a.as_ref()).unwrap();
+    s.factorize(a.as_ref()).unwrap();
+    assert!(matches!(
+        solve_checked(&mut s, a.as_ref(), &[1.0, f64::INFINITY], 1),
+        Err(SolverError::NonFinite { what: "right-hand side", index: 1 })
+    ));
+    assert!(matches!(solve_checked(&mut s, a.as_ref(), &[1.0], 1), Err(SolverError::DimensionMismatch(_))));
+}
+
+#[test]
+fn unavailable_backend_is_an_error_not_a_panic() {
+    let r = make_solver(SolverKind::Cholmod, &Ordering::Auto, vec![]);
+    assert_eq!(r.is_ok(), cfg!(feature = "cholmod"));
+    assert_eq!("cholmod".parse::<SolverKind>(), Ok(SolverKind::Cholmod));
+    assert!("umfpack".parse::<SolverKind>().unwrap_err().contains("umfpack"));
+}
