@@ -22,6 +22,7 @@
 pub mod assembly;
 pub mod constraints;
 pub mod element;
+pub mod generate;
 mod error;
 pub mod io;
 pub mod model;

@@ -95,12 +95,13 @@ fn solve(model_path: &Path, solver: SolverKind, ordering: Ordering, json: bool, 
             s.free_dofs
         );
         println!(
-            "solver {} (ordering {}): nnz(K) {}, nnz(L) {}, relative residual {:.2e}",
+            "solver {} (ordering {}): nnz(K) {}, nnz(L) {}, relative residual {:.2e}, backward error {:.2e}",
             s.backend,
             s.ordering,
             s.nnz,
             s.nnz_factor.map_or("-".into(), |v| v.to_string()),
-            s.relative_residual
+            s.relative_residual,
+            s.backward_error
         );
         println!(
             "time: pattern {:.3} s, fill {:.3} s, analyze {:.3} s, factorize {:.3} s, solve {:.3} s",

@@ -172,6 +172,7 @@ fn block_diag_with_singular_block(blocks: usize, size: usize, bad: usize) -> Csc
 fn not_positive_definite_is_reported_at_the_right_column() {
     // Diagonal with one negative entry: column 2, whatever the ordering.
     let a = CscMatrix::from_triplets(4, 4, &[(0, 0, 1.0), (1, 1, 2.0), (2, 2, -3.0), (3, 3, 4.0)]).unwrap();
+    #[allow(unused_mut)] // pushed to with the cholmod feature
     let mut solvers: Vec<Box<dyn LinearSolver>> = vec![
         Box::new(FaerCholesky::new(CholeskyVariant::Llt, Ordering::Natural)),
         Box::new(FaerCholesky::new(CholeskyVariant::Ldlt, Ordering::Amd)),
@@ -253,7 +254,11 @@ fn cg_reports_iterations_and_why_it_stopped() {
     let (_, report) = solve_checked(&mut cg, a, &sys.rhs, 1).unwrap();
     assert_eq!(report.info.stop, Some(StopReason::Converged));
     assert!(report.info.iterations.unwrap() > 0);
-    assert!(report.info.residual_estimate.unwrap() <= 1e-12);
+    // The reported residual is the true one, recomputed after the recursion converged (at the
+    // roundoff floor, summation order alone changes it by O(1), hence the factor 10).
+    let est = report.info.residual_estimate.unwrap();
+    assert!(est <= 10.0 * report.relative_residual && report.relative_residual <= 10.0 * est, "{est} vs {}", report.relative_residual);
+    assert!(report.backward_error <= 1e-14, "backward error {}", report.backward_error);
     let mut short = ConjugateGradient::new().with_max_iterations(3);
     short.analyze(a).unwrap();
     short.factorize(a).unwrap();

@@ -25,5 +25,5 @@ mod solver;
 pub use csc::{CscMatrix, CscRef, PatternFingerprint};
 pub use error::{SolverError, StopReason};
 pub use ordering::{compute_ordering, Ordering, Permutation};
-pub use residual::{relative_residual, solve_checked, SolveReport};
+pub use residual::{backward_error, relative_residual, solve_checked, SolveReport};
 pub use solver::{AnalyzeInfo, Capabilities, LinearSolver, SolveInfo};

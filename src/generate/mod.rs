@@ -1,0 +1,5 @@
+//! Model generators.
+
+mod grid;
+
+pub use grid::clamped_grid;
