@@ -22,8 +22,8 @@
 pub mod assembly;
 pub mod constraints;
 pub mod element;
-pub mod generate;
 mod error;
+pub mod generate;
 pub mod io;
 pub mod model;
 pub mod solve;

@@ -8,7 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "fibercell", version, about = "Effective mechanical properties of textiles from fiber-network cells")]
+#[command(
+    name = "fibercell",
+    version,
+    about = "Effective mechanical properties of textiles from fiber-network cells"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -53,11 +57,19 @@ fn parse_ordering(s: &str) -> Result<Ordering, String> {
         "amd" => Ok(Ordering::Amd),
         "nd" | "nested-dissection" | "metis" => Ok(Ordering::NestedDissection),
         "natural" => Ok(Ordering::Natural),
-        _ => Err(format!("unknown ordering \"{s}\" (use auto, amd, nd or natural)")),
+        _ => Err(format!(
+            "unknown ordering \"{s}\" (use auto, amd, nd or natural)"
+        )),
     }
 }
 
-fn solve(model_path: &Path, solver: SolverKind, ordering: Ordering, json: bool, out: &Path) -> Result<(), Error> {
+fn solve(
+    model_path: &Path,
+    solver: SolverKind,
+    ordering: Ordering,
+    json: bool,
+    out: &Path,
+) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
     let options = SolveOptions {
         solver,
@@ -74,9 +86,15 @@ fn solve(model_path: &Path, solver: SolverKind, ordering: Ordering, json: bool, 
         path: out.display().to_string(),
         message: e.to_string(),
     })?;
-    io::write_atomic(&out.join("displacements.csv"), io::displacements_csv(&model, &sol).as_bytes())?;
+    io::write_atomic(
+        &out.join("displacements.csv"),
+        io::displacements_csv(&model, &sol).as_bytes(),
+    )?;
     io::write_atomic(&out.join("displacements.json"), pretty.as_bytes())?;
-    io::write_atomic(&out.join("deformed.vtu"), io::deformed_vtu(&model, &sol).as_bytes())?;
+    io::write_atomic(
+        &out.join("deformed.vtu"),
+        io::deformed_vtu(&model, &sol).as_bytes(),
+    )?;
     if json {
         println!("{pretty}");
     } else {
@@ -107,7 +125,10 @@ fn solve(model_path: &Path, solver: SolverKind, ordering: Ordering, json: bool, 
             "time: pattern {:.3} s, fill {:.3} s, analyze {:.3} s, factorize {:.3} s, solve {:.3} s",
             s.timings.pattern, s.timings.fill, s.timings.analyze, s.timings.factorize, s.timings.solve
         );
-        println!("largest displacement {max_u:.6e} m; results in {}", out.display());
+        println!(
+            "largest displacement {max_u:.6e} m; results in {}",
+            out.display()
+        );
     }
     Ok(())
 }
@@ -120,13 +141,22 @@ fn export_matrix(model_path: &Path, out: &Path) -> Result<(), Error> {
         model_path.display(),
         sys.dofs.n_free()
     );
-    io::write_atomic(out, io::write_matrix_market(sys.matrix()?, &comment).as_bytes())
+    io::write_atomic(
+        out,
+        io::write_matrix_market(sys.matrix()?, &comment).as_bytes(),
+    )
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match cli.command {
-        Command::Solve { model, solver, ordering, json, output } => solve(&model, solver, ordering, json, &output),
+        Command::Solve {
+            model,
+            solver,
+            ordering,
+            json,
+            output,
+        } => solve(&model, solver, ordering, json, &output),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
     };
     match r {

@@ -12,7 +12,9 @@ fn assemble(d: &ModelDescription, mode: FillMode) -> (DofMap, Pattern, Vec<f64>)
     let dofs = DofMap::new(&model);
     let pattern = Pattern::new(&model, &dofs).unwrap();
     let mut values = vec![f64::NAN; pattern.nnz()];
-    Assembler::new(&model).fill(&model, &pattern, &mut values, mode).unwrap();
+    Assembler::new(&model)
+        .fill(&model, &pattern, &mut values, mode)
+        .unwrap();
     (dofs, pattern, values)
 }
 
@@ -55,7 +57,9 @@ fn fill_equals_dense_sum_of_element_matrices() {
         }
     }
     let reduced = dense(&p, &v);
-    let free: Vec<usize> = (0..dofs.n_global()).filter(|&g| dofs.reduced(g).is_some()).collect();
+    let free: Vec<usize> = (0..dofs.n_global())
+        .filter(|&g| dofs.reduced(g).is_some())
+        .collect();
     let max = full.amax();
     for (i, &gi) in free.iter().enumerate() {
         for (j, &gj) in free.iter().enumerate() {
@@ -67,7 +71,10 @@ fn fill_equals_dense_sum_of_element_matrices() {
 #[test]
 fn stiffness_is_invariant_under_rigid_rotation() {
     let d = grid(4, 2, 0.02, 5e-4);
-    let q = Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(Vector3::new(0.3, -1.2, 0.7)), 1.1);
+    let q = Rotation3::from_axis_angle(
+        &nalgebra::Unit::new_normalize(Vector3::new(0.3, -1.2, 0.7)),
+        1.1,
+    );
     let mut rotated = d.clone();
     for n in &mut rotated.nodes {
         let x = q * Vector3::new(n.x[0], n.x[1], n.x[2]) + Vector3::new(0.5, -0.25, 2.0);
@@ -85,5 +92,8 @@ fn stiffness_is_invariant_under_rigid_rotation() {
     }
     let expected = &t * k * t.transpose();
     let err = (&expected - &k_r).amax();
-    assert!(err <= 1e-12 * k_r.amax(), "rotated stiffness differs by {err:e}");
+    assert!(
+        err <= 1e-12 * k_r.amax(),
+        "rotated stiffness differs by {err:e}"
+    );
 }

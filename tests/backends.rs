@@ -5,7 +5,9 @@
 mod common;
 use common::*;
 use fibercell::solve::{make_solver, solve_static, ReducedSystem, SolveOptions, SolverKind};
-use fibercell::solver::{solve_checked, CscMatrix, CscRef, LinearSolver, Ordering, SolverError, StopReason};
+use fibercell::solver::{
+    solve_checked, CscMatrix, CscRef, LinearSolver, Ordering, SolverError, StopReason,
+};
 use fibercell::{io, Error};
 use fibercell_cg::ConjugateGradient;
 use fibercell_faer::{CholeskyVariant, FaerCholesky, FaerLu};
@@ -13,12 +15,23 @@ use std::path::Path;
 
 fn direct_solvers() -> Vec<(String, Box<dyn LinearSolver>)> {
     let mut v: Vec<(String, Box<dyn LinearSolver>)> = Vec::new();
-    for o in [Ordering::Auto, Ordering::Natural, Ordering::Amd, Ordering::NestedDissection] {
+    for o in [
+        Ordering::Auto,
+        Ordering::Natural,
+        Ordering::Amd,
+        Ordering::NestedDissection,
+    ] {
         for var in [CholeskyVariant::Llt, CholeskyVariant::Ldlt] {
-            v.push((format!("faer {var:?} {}", o.name()), Box::new(FaerCholesky::new(var, o.clone()))));
+            v.push((
+                format!("faer {var:?} {}", o.name()),
+                Box::new(FaerCholesky::new(var, o.clone())),
+            ));
         }
         #[cfg(feature = "cholmod")]
-        v.push((format!("cholmod {}", o.name()), Box::new(fibercell_cholmod::Cholmod::new(o.clone()))));
+        v.push((
+            format!("cholmod {}", o.name()),
+            Box::new(fibercell_cholmod::Cholmod::new(o.clone())),
+        ));
     }
     v.push(("faer lu".into(), Box::new(FaerLu::new())));
     v.push(("cg".into(), Box::new(ConjugateGradient::new())));
@@ -29,8 +42,14 @@ fn systems() -> Vec<(String, ReducedSystem)> {
     let frame = io::load_model(Path::new("fixtures/ok_frame3d.toml")).unwrap();
     let grid = build(&grid(8, 3, 0.01, 3e-4));
     vec![
-        ("frame".into(), ReducedSystem::assemble(&frame, Default::default()).unwrap()),
-        ("grid".into(), ReducedSystem::assemble(&grid, Default::default()).unwrap()),
+        (
+            "frame".into(),
+            ReducedSystem::assemble(&frame, Default::default()).unwrap(),
+        ),
+        (
+            "grid".into(),
+            ReducedSystem::assemble(&grid, Default::default()).unwrap(),
+        ),
     ]
 }
 
@@ -49,18 +68,33 @@ fn every_backend_and_ordering_agrees() {
         let scale = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let mut solvers = direct_solvers();
         let p = fibercell::solver::compute_ordering(a, &Ordering::NestedDissection).unwrap();
-        solvers.push(("faer given".into(), Box::new(FaerCholesky::new(CholeskyVariant::Llt, Ordering::Given(p.fwd)))));
+        solvers.push((
+            "faer given".into(),
+            Box::new(FaerCholesky::new(
+                CholeskyVariant::Llt,
+                Ordering::Given(p.fwd),
+            )),
+        ));
         solvers.push((
             "cg node blocks".into(),
             Box::new(ConjugateGradient::new().with_blocks(sys.dofs.node_block_starts())),
         ));
         for (sname, mut s) in solvers {
-            s.analyze(a).unwrap_or_else(|e| panic!("{sname} on {name}: {e}"));
-            s.factorize(a).unwrap_or_else(|e| panic!("{sname} on {name}: {e}"));
+            s.analyze(a)
+                .unwrap_or_else(|e| panic!("{sname} on {name}: {e}"));
+            s.factorize(a)
+                .unwrap_or_else(|e| panic!("{sname} on {name}: {e}"));
             let (x, report) = solve_checked(s.as_mut(), a, &sys.rhs, 1).unwrap();
-            assert!(report.relative_residual < 1e-9, "{sname} on {name}: residual {}", report.relative_residual);
+            assert!(
+                report.relative_residual < 1e-9,
+                "{sname} on {name}: residual {}",
+                report.relative_residual
+            );
             for (p, q) in x.iter().zip(&want) {
-                assert!((p - q).abs() <= 1e-8 * scale, "{sname} on {name}: {p} vs {q}");
+                assert!(
+                    (p - q).abs() <= 1e-8 * scale,
+                    "{sname} on {name}: {p} vs {q}"
+                );
             }
         }
     }
@@ -69,9 +103,14 @@ fn every_backend_and_ordering_agrees() {
 #[test]
 fn every_backend_through_the_mechanics() {
     let m = io::load_model(Path::new("fixtures/ok_frame3d.toml")).unwrap();
-    let want = solve_static(&m, &SolveOptions::default()).unwrap().displacements;
+    let want = solve_static(&m, &SolveOptions::default())
+        .unwrap()
+        .displacements;
     for kind in SolverKind::ALL {
-        let opts = SolveOptions { solver: kind, ..SolveOptions::default() };
+        let opts = SolveOptions {
+            solver: kind,
+            ..SolveOptions::default()
+        };
         match solve_static(&m, &opts) {
             Ok(sol) => {
                 assert!(kind.is_available());
@@ -140,11 +179,21 @@ fn symbolic_analysis_is_reused_and_many_rhs_solve_at_once() {
         }
     }
     // A different pattern is refused until analyze runs again.
-    let other = CscMatrix::from_triplets(n, n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>()).unwrap();
-    assert_eq!(s.factorize(other.as_ref()), Err(SolverError::PatternChanged));
+    let other =
+        CscMatrix::from_triplets(n, n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>()).unwrap();
+    assert_eq!(
+        s.factorize(other.as_ref()),
+        Err(SolverError::PatternChanged)
+    );
     let mut fresh = FaerCholesky::default();
-    assert!(matches!(fresh.factorize(a), Err(SolverError::OutOfOrder(..))));
-    assert!(matches!(fresh.solve_in_place(&mut vec![0.0; n], 1), Err(SolverError::OutOfOrder(..))));
+    assert!(matches!(
+        fresh.factorize(a),
+        Err(SolverError::OutOfOrder(..))
+    ));
+    assert!(matches!(
+        fresh.solve_in_place(&mut vec![0.0; n], 1),
+        Err(SolverError::OutOfOrder(..))
+    ));
 }
 
 fn block_diag_with_singular_block(blocks: usize, size: usize, bad: usize) -> CscMatrix {
@@ -171,7 +220,8 @@ fn block_diag_with_singular_block(blocks: usize, size: usize, bad: usize) -> Csc
 #[test]
 fn not_positive_definite_is_reported_at_the_right_column() {
     // Diagonal with one negative entry: column 2, whatever the ordering.
-    let a = CscMatrix::from_triplets(4, 4, &[(0, 0, 1.0), (1, 1, 2.0), (2, 2, -3.0), (3, 3, 4.0)]).unwrap();
+    let a = CscMatrix::from_triplets(4, 4, &[(0, 0, 1.0), (1, 1, 2.0), (2, 2, -3.0), (3, 3, 4.0)])
+        .unwrap();
     #[allow(unused_mut)] // pushed to with the cholmod feature
     let mut solvers: Vec<Box<dyn LinearSolver>> = vec![
         Box::new(FaerCholesky::new(CholeskyVariant::Llt, Ordering::Natural)),
@@ -182,7 +232,9 @@ fn not_positive_definite_is_reported_at_the_right_column() {
     for mut s in solvers {
         s.analyze(a.as_ref()).unwrap();
         match s.factorize(a.as_ref()) {
-            Err(SolverError::NotPositiveDefinite { column, .. }) => assert_eq!(column, 2, "{}", s.name()),
+            Err(SolverError::NotPositiveDefinite { column, .. }) => {
+                assert_eq!(column, 2, "{}", s.name())
+            }
             other => panic!("{}: {other:?}", s.name()),
         }
     }
@@ -197,7 +249,10 @@ fn not_positive_definite_is_reported_at_the_right_column() {
                 s.analyze(a.as_ref()).unwrap();
                 match s.factorize(a.as_ref()) {
                     Err(SolverError::NotPositiveDefinite { column, pivot }) => {
-                        assert!((bad * size..(bad + 1) * size).contains(&column), "{var:?} {o:?}: column {column}");
+                        assert!(
+                            (bad * size..(bad + 1) * size).contains(&column),
+                            "{var:?} {o:?}: column {column}"
+                        );
                         assert!(pivot < 1e-12);
                     }
                     other => panic!("{var:?} {o:?}: {other:?}"),
@@ -222,7 +277,16 @@ fn lu_solves_nonsymmetric_systems_and_flags_zero_pivots() {
     let a = CscMatrix::from_triplets(
         3,
         3,
-        &[(0, 0, 4.0), (0, 1, 1.0), (1, 0, -2.0), (1, 1, 5.0), (1, 2, 1.0), (2, 1, 3.0), (2, 2, 6.0), (0, 2, 0.5)],
+        &[
+            (0, 0, 4.0),
+            (0, 1, 1.0),
+            (1, 0, -2.0),
+            (1, 1, 5.0),
+            (1, 2, 1.0),
+            (2, 1, 3.0),
+            (2, 2, 6.0),
+            (0, 2, 0.5),
+        ],
     )
     .unwrap();
     let x = [1.0, -2.0, 3.0];
@@ -238,10 +302,24 @@ fn lu_solves_nonsymmetric_systems_and_flags_zero_pivots() {
         assert!((got[k] - x[k]).abs() < 1e-13);
     }
     // Numerically singular (row 2 = 2 · row 1): an error, not a solution.
-    let s = CscMatrix::from_triplets(3, 3, &[(0, 0, 1.0), (0, 1, 2.0), (1, 0, 2.0), (1, 1, 4.0), (2, 2, 1.0)]).unwrap();
+    let s = CscMatrix::from_triplets(
+        3,
+        3,
+        &[
+            (0, 0, 1.0),
+            (0, 1, 2.0),
+            (1, 0, 2.0),
+            (1, 1, 4.0),
+            (2, 2, 1.0),
+        ],
+    )
+    .unwrap();
     let mut lu = FaerLu::new();
     lu.analyze(s.as_ref()).unwrap();
-    assert!(matches!(lu.factorize(s.as_ref()), Err(SolverError::Singular { .. })));
+    assert!(matches!(
+        lu.factorize(s.as_ref()),
+        Err(SolverError::Singular { .. })
+    ));
 }
 
 #[test]
@@ -257,13 +335,26 @@ fn cg_reports_iterations_and_why_it_stopped() {
     // The reported residual is the true one, recomputed after the recursion converged (at the
     // roundoff floor, summation order alone changes it by O(1), hence the factor 10).
     let est = report.info.residual_estimate.unwrap();
-    assert!(est <= 10.0 * report.relative_residual && report.relative_residual <= 10.0 * est, "{est} vs {}", report.relative_residual);
-    assert!(report.backward_error <= 1e-14, "backward error {}", report.backward_error);
+    assert!(
+        est <= 10.0 * report.relative_residual && report.relative_residual <= 10.0 * est,
+        "{est} vs {}",
+        report.relative_residual
+    );
+    assert!(
+        report.backward_error <= 1e-14,
+        "backward error {}",
+        report.backward_error
+    );
     let mut short = ConjugateGradient::new().with_max_iterations(3);
     short.analyze(a).unwrap();
     short.factorize(a).unwrap();
     match short.solve_in_place(&mut sys.rhs.clone(), 1) {
-        Err(SolverError::NoConvergence { iterations, residual, reason, .. }) => {
+        Err(SolverError::NoConvergence {
+            iterations,
+            residual,
+            reason,
+            ..
+        }) => {
             assert_eq!(iterations, 3);
             assert!(residual > 0.0 && residual.is_finite());
             assert_eq!(reason, StopReason::MaxIterations);
@@ -271,12 +362,16 @@ fn cg_reports_iterations_and_why_it_stopped() {
         other => panic!("{other:?}"),
     }
     // Indefinite with positive diagonal blocks: CG breaks down.
-    let ind = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (0, 1, 2.0), (1, 0, 2.0), (1, 1, 1.0)]).unwrap();
+    let ind = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (0, 1, 2.0), (1, 0, 2.0), (1, 1, 1.0)])
+        .unwrap();
     let mut cg = ConjugateGradient::new().with_block_size(1);
     cg.analyze(ind.as_ref()).unwrap();
     cg.factorize(ind.as_ref()).unwrap();
-    match cg.solve_in_place(&mut vec![1.0, -1.0], 1) {
-        Err(SolverError::NoConvergence { reason: StopReason::Breakdown, .. }) => {}
+    match cg.solve_in_place(&mut [1.0, -1.0], 1) {
+        Err(SolverError::NoConvergence {
+            reason: StopReason::Breakdown,
+            ..
+        }) => {}
         other => panic!("{other:?}"),
     }
 }
@@ -285,15 +380,27 @@ fn cg_reports_iterations_and_why_it_stopped() {
 fn non_finite_inputs_are_errors() {
     let a = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (1, 1, f64::NAN)]).unwrap();
     let mut s = FaerCholesky::default();
-    assert!(matches!(s.analyze(a.as_ref()), Err(SolverError::NonFinite { what: "matrix", index: 1 })));
+    assert!(matches!(
+        s.analyze(a.as_ref()),
+        Err(SolverError::NonFinite {
+            what: "matrix",
+            index: 1
+        })
+    ));
     let a = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (1, 1, 1.0)]).unwrap();
     s.analyze(a.as_ref()).unwrap();
     s.factorize(a.as_ref()).unwrap();
     assert!(matches!(
         solve_checked(&mut s, a.as_ref(), &[1.0, f64::INFINITY], 1),
-        Err(SolverError::NonFinite { what: "right-hand side", index: 1 })
+        Err(SolverError::NonFinite {
+            what: "right-hand side",
+            index: 1
+        })
     ));
-    assert!(matches!(solve_checked(&mut s, a.as_ref(), &[1.0], 1), Err(SolverError::DimensionMismatch(_))));
+    assert!(matches!(
+        solve_checked(&mut s, a.as_ref(), &[1.0], 1),
+        Err(SolverError::DimensionMismatch(_))
+    ));
 }
 
 #[test]
@@ -301,5 +408,8 @@ fn unavailable_backend_is_an_error_not_a_panic() {
     let r = make_solver(SolverKind::Cholmod, &Ordering::Auto, vec![]);
     assert_eq!(r.is_ok(), cfg!(feature = "cholmod"));
     assert_eq!("cholmod".parse::<SolverKind>(), Ok(SolverKind::Cholmod));
-    assert!("umfpack".parse::<SolverKind>().unwrap_err().contains("umfpack"));
+    assert!("umfpack"
+        .parse::<SolverKind>()
+        .unwrap_err()
+        .contains("umfpack"));
 }

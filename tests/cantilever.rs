@@ -25,7 +25,10 @@ fn tip(a: [f64; 3], b: [f64; 3], n: usize, f: [f64; 3], m: [f64; 3]) -> [f64; 6]
 }
 
 fn check(got: f64, want: f64, scale: f64, what: &str) {
-    assert!((got - want).abs() <= TOL * scale, "{what}: got {got:e}, want {want:e}");
+    assert!(
+        (got - want).abs() <= TOL * scale,
+        "{what}: got {got:e}, want {want:e}"
+    );
 }
 
 #[test]
@@ -50,7 +53,12 @@ fn transverse_forces_in_both_planes() {
     check(u[5], th, th, "rz");
     let u = tip([0.0; 3], [L, 0.0, 0.0], 5, [0.0, 0.0, p], [0.0; 3]);
     check(u[2], d, d, "uz");
-    check(u[4], -th, th, "ry (right-hand rule: +z load turns the tip about −y)");
+    check(
+        u[4],
+        -th,
+        th,
+        "ry (right-hand rule: +z load turns the tip about −y)",
+    );
 }
 
 #[test]
@@ -69,7 +77,13 @@ fn torsion_and_end_moment() {
 fn fiber_parallel_to_global_z() {
     let (ea, ei, gj) = props();
     let (p, t) = (2.0, 0.7);
-    let u = tip([0.0; 3], [0.0, 0.0, L], 4, [p, 0.0, -100.0 * p], [0.0, 0.0, t]);
+    let u = tip(
+        [0.0; 3],
+        [0.0, 0.0, L],
+        4,
+        [p, 0.0, -100.0 * p],
+        [0.0, 0.0, t],
+    );
     let d = p * L.powi(3) / (3.0 * ei);
     check(u[0], d, d, "ux");
     check(u[4], p * L * L / (2.0 * ei), d, "ry");
@@ -84,8 +98,18 @@ fn oblique_cantilever_matches_rotated_closed_form() {
     let e = [1.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0];
     let n = [2.0 / 3.0, 1.0 / 3.0, -2.0 / 3.0]; // ⟂ e
     let (pa, pt) = (500.0, 4.0);
-    let f = [pa * e[0] + pt * n[0], pa * e[1] + pt * n[1], pa * e[2] + pt * n[2]];
-    let u = tip([0.1, -0.2, 0.3], [0.1 + L * e[0], -0.2 + L * e[1], 0.3 + L * e[2]], 6, f, [0.0; 3]);
+    let f = [
+        pa * e[0] + pt * n[0],
+        pa * e[1] + pt * n[1],
+        pa * e[2] + pt * n[2],
+    ];
+    let u = tip(
+        [0.1, -0.2, 0.3],
+        [0.1 + L * e[0], -0.2 + L * e[1], 0.3 + L * e[2]],
+        6,
+        f,
+        [0.0; 3],
+    );
     let (da, dt) = (pa * L / ea, pt * L.powi(3) / (3.0 * ei));
     for k in 0..3 {
         let want = da * e[k] + dt * n[k];
@@ -93,7 +117,11 @@ fn oblique_cantilever_matches_rotated_closed_form() {
     }
     // Rotation θ = PL²/(2EI) about e × n.
     let th = pt * L * L / (2.0 * ei);
-    let axis = [e[1] * n[2] - e[2] * n[1], e[2] * n[0] - e[0] * n[2], e[0] * n[1] - e[1] * n[0]];
+    let axis = [
+        e[1] * n[2] - e[2] * n[1],
+        e[2] * n[0] - e[0] * n[2],
+        e[0] * n[1] - e[1] * n[0],
+    ];
     for k in 0..3 {
         check(u[3 + k], th * axis[k], th, &format!("r{k}"));
     }

@@ -5,7 +5,10 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fibercell")).args(args).output().expect("runs")
+    Command::new(env!("CARGO_BIN_EXE_fibercell"))
+        .args(args)
+        .output()
+        .expect("runs")
 }
 
 fn tmpdir(name: &str) -> std::path::PathBuf {
@@ -17,23 +20,38 @@ fn tmpdir(name: &str) -> std::path::PathBuf {
 #[test]
 fn solve_writes_csv_json_vtu_and_prints_json() {
     let out = tmpdir("solve");
-    let o = run(&["solve", "fixtures/ok_frame3d.inp", "--json", "-o", out.to_str().unwrap()]);
+    let o = run(&[
+        "solve",
+        "fixtures/ok_frame3d.inp",
+        "--json",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is one JSON document");
+    let doc: serde_json::Value =
+        serde_json::from_slice(&o.stdout).expect("stdout is one JSON document");
     let disp = doc["displacements"].as_object().unwrap();
     assert_eq!(disp.len(), 7);
     assert_eq!(disp["1"].as_array().unwrap().len(), 6);
-    assert!(disp["1"].as_array().unwrap().iter().all(|v| v.as_f64() == Some(0.0)));
+    assert!(disp["1"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|v| v.as_f64() == Some(0.0)));
     assert_eq!(doc["solver"]["backend"], "faer-cholesky");
     assert!(doc["solver"]["relative_residual"].as_f64().unwrap() < 1e-9);
     assert!(doc["solver"]["timings"]["factorize"].as_f64().is_some());
     let csv = std::fs::read_to_string(out.join("displacements.csv")).unwrap();
     assert_eq!(csv.lines().count(), 8);
     assert!(csv.starts_with("node,ux,uy,uz,rx,ry,rz\n"));
-    let file: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("displacements.json")).unwrap()).unwrap();
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("displacements.json")).unwrap())
+            .unwrap();
     assert_eq!(file["displacements"], doc["displacements"]);
     let vtu = std::fs::read_to_string(out.join("deformed.vtu")).unwrap();
-    assert!(vtu.contains("NumberOfPoints=\"7\" NumberOfCells=\"6\"") && vtu.contains("Name=\"radius\""));
+    assert!(
+        vtu.contains("NumberOfPoints=\"7\" NumberOfCells=\"6\"") && vtu.contains("Name=\"radius\"")
+    );
     // Only the three outputs, no temporary leftovers.
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 3);
 }
@@ -43,12 +61,22 @@ fn export_matrix_writes_the_lower_triangle() {
     let out = tmpdir("mtx");
     std::fs::create_dir_all(&out).unwrap();
     let f = out.join("K.mtx");
-    let o = run(&["export-matrix", "fixtures/ok_frame3d.toml", "-o", f.to_str().unwrap()]);
+    let o = run(&[
+        "export-matrix",
+        "fixtures/ok_frame3d.toml",
+        "-o",
+        f.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read_to_string(&f).unwrap();
     let mut lines = text.lines().filter(|l| !l.starts_with('%'));
     assert!(text.starts_with("%%MatrixMarket matrix coordinate real symmetric\n"));
-    let header: Vec<usize> = lines.next().unwrap().split_whitespace().map(|x| x.parse().unwrap()).collect();
+    let header: Vec<usize> = lines
+        .next()
+        .unwrap()
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
     // Compare with the library's reduced system.
     let m = fibercell::io::load_model(Path::new("fixtures/ok_frame3d.toml")).unwrap();
     let sys = fibercell::solve::ReducedSystem::assemble(&m, Default::default()).unwrap();
@@ -59,7 +87,11 @@ fn export_matrix_writes_the_lower_triangle() {
     let mut count = 0;
     for l in lines {
         let p: Vec<&str> = l.split_whitespace().collect();
-        let (i, j, v): (usize, usize, f64) = (p[0].parse().unwrap(), p[1].parse().unwrap(), p[2].parse().unwrap());
+        let (i, j, v): (usize, usize, f64) = (
+            p[0].parse().unwrap(),
+            p[1].parse().unwrap(),
+            p[2].parse().unwrap(),
+        );
         assert!(i >= j);
         let (rows, vals) = a.col(j - 1);
         let k = rows.binary_search(&(i - 1)).unwrap();
@@ -72,10 +104,19 @@ fn export_matrix_writes_the_lower_triangle() {
 #[test]
 fn errors_are_one_line_with_a_non_zero_exit() {
     for (args, needle) in [
-        (vec!["solve", "fixtures/bad_floating_fiber.toml"], "fiber 2 is held by nothing"),
+        (
+            vec!["solve", "fixtures/bad_floating_fiber.toml"],
+            "fiber 2 is held by nothing",
+        ),
         (vec!["solve", "fixtures/bad_nan_coordinate.toml"], "node 2"),
-        (vec!["solve", "fixtures/bad_unknown_key.json"], "bad_unknown_key.json:5"),
-        (vec!["solve", "fixtures/bad_unsupported_keyword.inp"], "bad_unsupported_keyword.inp:9: unsupported Abaqus keyword *Density"),
+        (
+            vec!["solve", "fixtures/bad_unknown_key.json"],
+            "bad_unknown_key.json:5",
+        ),
+        (
+            vec!["solve", "fixtures/bad_unsupported_keyword.inp"],
+            "bad_unsupported_keyword.inp:9: unsupported Abaqus keyword *Density",
+        ),
         (vec!["solve", "fixtures/missing.toml"], "cannot read"),
     ] {
         let o = run(&args);
@@ -88,6 +129,18 @@ fn errors_are_one_line_with_a_non_zero_exit() {
     let o = run(&["solve", "fixtures/ok_frame3d.toml", "--solver", "pardiso"]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("unknown solver"));
-    let o = run(&["solve", "fixtures/ok_frame3d.toml", "--solver", "cholmod", "-o", tmpdir("ch").to_str().unwrap()]);
-    assert_eq!(o.status.success(), cfg!(feature = "cholmod"), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run(&[
+        "solve",
+        "fixtures/ok_frame3d.toml",
+        "--solver",
+        "cholmod",
+        "-o",
+        tmpdir("ch").to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.success(),
+        cfg!(feature = "cholmod"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }

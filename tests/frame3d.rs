@@ -25,29 +25,67 @@ fn l_frame_out_of_plane_load_matches_castigliano() {
         name: None,
         materials: vec![steel()],
         nodes: vec![
-            NodeSpec { id: 1, x: [0.0, 0.0, 0.0] },
-            NodeSpec { id: 2, x: [0.0, 0.0, a / 2.0] },
-            NodeSpec { id: 3, x: [0.0, 0.0, a] },
-            NodeSpec { id: 4, x: [b, 0.0, a] },
+            NodeSpec {
+                id: 1,
+                x: [0.0, 0.0, 0.0],
+            },
+            NodeSpec {
+                id: 2,
+                x: [0.0, 0.0, a / 2.0],
+            },
+            NodeSpec {
+                id: 3,
+                x: [0.0, 0.0, a],
+            },
+            NodeSpec {
+                id: 4,
+                x: [b, 0.0, a],
+            },
         ],
         fibers: vec![
-            FiberSpec { id: 1, nodes: vec![1, 2, 3], radius: r, material: "steel".into() },
-            FiberSpec { id: 2, nodes: vec![3, 4], radius: r, material: "steel".into() },
+            FiberSpec {
+                id: 1,
+                nodes: vec![1, 2, 3],
+                radius: r,
+                material: "steel".into(),
+            },
+            FiberSpec {
+                id: 2,
+                nodes: vec![3, 4],
+                radius: r,
+                material: "steel".into(),
+            },
         ],
-        supports: vec![SupportSpec { node: 1, dofs: vec![DofSet::All], value: 0.0 }],
-        loads: vec![LoadSpec { node: 4, force: [0.0, p, 0.0], moment: [0.0; 3] }],
+        supports: vec![SupportSpec {
+            node: 1,
+            dofs: vec![DofSet::All],
+            value: 0.0,
+        }],
+        loads: vec![LoadSpec {
+            node: 4,
+            force: [0.0, p, 0.0],
+            moment: [0.0; 3],
+        }],
     };
     let sol = solve(&build(&d));
     let ei = E * PI * r.powi(4) / 4.0;
     let gj = E / (2.0 * (1.0 + NU)) * PI * r.powi(4) / 2.0;
     let want = p * b.powi(3) / (3.0 * ei) + p * a.powi(3) / (3.0 * ei) + p * b * b * a / gj;
     let got = sol.displacements[3][1];
-    assert!(rel(got, want, 0.0) <= 1e-10, "δy = {got:e}, closed form {want:e}");
+    assert!(
+        rel(got, want, 0.0) <= 1e-10,
+        "δy = {got:e}, closed form {want:e}"
+    );
     // Column top: torsion φz = P b a / (GJ).
     let phi = sol.displacements[2][5];
     assert!(rel(phi, p * b * a / gj, 0.0) <= 1e-10);
     // The clamp reaction balances the load along y.
-    let fy: f64 = sol.reactions.iter().filter(|r| r.dof.index() == 1).map(|r| r.value).sum();
+    let fy: f64 = sol
+        .reactions
+        .iter()
+        .filter(|r| r.dof.index() == 1)
+        .map(|r| r.value)
+        .sum();
     assert!(rel(fy, -p, 0.0) <= 1e-9);
 }
 
@@ -69,7 +107,13 @@ fn independent_solution(m: &Model) -> Vec<f64> {
         let e2 = e1.cross(&skew).normalize();
         let e3 = e1.cross(&e2);
         let rot = Matrix3::from_rows(&[e1.transpose(), e2.transpose(), e3.transpose()]);
-        let kl = quadrature_local_stiffness(mat.young * a, mat.young * i, mat.young * i, mat.shear * j, l);
+        let kl = quadrature_local_stiffness(
+            mat.young * a,
+            mat.young * i,
+            mat.young * i,
+            mat.shear * j,
+            l,
+        );
         let mut t = DMatrix::<f64>::zeros(12, 12);
         for b in 0..4 {
             t.view_mut((3 * b, 3 * b), (3, 3)).copy_from(&rot);
@@ -111,22 +155,49 @@ fn fixture_frame_matches_independent_dense_derivation() {
     for (node, u) in sol.displacements.iter().enumerate() {
         for d in 0..6 {
             let w = want[6 * node + d];
-            assert!((u[d] - w).abs() <= 1e-9 * scale, "node {} dof {d}: {} vs {}", m.nodes[node].id, u[d], w);
+            assert!(
+                (u[d] - w).abs() <= 1e-9 * scale,
+                "node {} dof {d}: {} vs {}",
+                m.nodes[node].id,
+                u[d],
+                w
+            );
         }
     }
     // Equilibrium of the whole frame: reactions + loads sum to zero force.
     for k in 0..3 {
-        let r: f64 = sol.reactions.iter().filter(|r| r.dof.index() == k).map(|r| r.value).sum();
-        let l: f64 = m.loads.iter().filter(|l| l.dof.index() == k).map(|l| l.value).sum();
-        assert!((r + l).abs() <= 1e-8 * 300.0, "force balance along {k}: {r} + {l}");
+        let r: f64 = sol
+            .reactions
+            .iter()
+            .filter(|r| r.dof.index() == k)
+            .map(|r| r.value)
+            .sum();
+        let l: f64 = m
+            .loads
+            .iter()
+            .filter(|l| l.dof.index() == k)
+            .map(|l| l.value)
+            .sum();
+        assert!(
+            (r + l).abs() <= 1e-8 * 300.0,
+            "force balance along {k}: {r} + {l}"
+        );
     }
 }
 
 #[test]
 fn prescribed_displacement_matches_independent_derivation() {
     let mut d = io::read_description(Path::new("fixtures/ok_frame3d.toml")).unwrap();
-    d.supports.push(SupportSpec { node: 6, dofs: vec![DofSet::Rz], value: 0.003 });
-    d.supports.push(SupportSpec { node: 5, dofs: vec![DofSet::Rx], value: -0.002 });
+    d.supports.push(SupportSpec {
+        node: 6,
+        dofs: vec![DofSet::Rz],
+        value: 0.003,
+    });
+    d.supports.push(SupportSpec {
+        node: 5,
+        dofs: vec![DofSet::Rx],
+        value: -0.002,
+    });
     d.supports[2].value = 0.0;
     let m = build(&d);
     let sol = solve(&m);
@@ -145,15 +216,22 @@ fn toml_json_and_abaqus_give_the_same_result() {
     let load = |f: &str| {
         let m = io::load_model(Path::new(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
         let s = solve(&m);
-        let mut by_id: Vec<(u64, [f64; 6])> = m.nodes.iter().map(|n| n.id).zip(s.displacements).collect();
+        let mut by_id: Vec<(u64, [f64; 6])> =
+            m.nodes.iter().map(|n| n.id).zip(s.displacements).collect();
         by_id.sort_by_key(|p| p.0);
         by_id
     };
     let t = load("fixtures/ok_frame3d.toml");
     let j = load("fixtures/ok_frame3d.json");
     let a = load("fixtures/ok_frame3d.inp");
-    assert_eq!(t, j, "TOML and JSON are the same schema: bit-identical results");
-    let scale = t.iter().flat_map(|p| p.1).fold(0.0f64, |m, v| m.max(v.abs()));
+    assert_eq!(
+        t, j,
+        "TOML and JSON are the same schema: bit-identical results"
+    );
+    let scale = t
+        .iter()
+        .flat_map(|p| p.1)
+        .fold(0.0f64, |m, v| m.max(v.abs()));
     for ((ia, ua), (ib, ub)) in t.iter().zip(&a) {
         assert_eq!(ia, ib);
         for k in 0..6 {

@@ -101,7 +101,12 @@ fn local_stiffness_equals_quadrature_of_bt_d_b() {
     let max = k.amax();
     for i in 0..12 {
         for j in 0..12 {
-            assert!((closed[(i, j)] - k[(i, j)]).abs() <= 1e-12 * max, "entry ({i},{j}): {} vs {}", closed[(i, j)], k[(i, j)]);
+            assert!(
+                (closed[(i, j)] - k[(i, j)]).abs() <= 1e-12 * max,
+                "entry ({i},{j}): {} vs {}",
+                closed[(i, j)],
+                k[(i, j)]
+            );
         }
     }
 }

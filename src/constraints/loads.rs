@@ -69,7 +69,13 @@ pub fn reduced_rhs(model: &Model, dofs: &DofMap) -> Vec<f64> {
     if dofs.has_nonzero_prescribed() {
         // K u_c with u_c the prescribed values (zero on free DOFs).
         let uc: Vec<f64> = (0..dofs.n_global())
-            .map(|g| if dofs.reduced(g).is_some() { 0.0 } else { dofs.prescribed_value(g) })
+            .map(|g| {
+                if dofs.reduced(g).is_some() {
+                    0.0
+                } else {
+                    dofs.prescribed_value(g)
+                }
+            })
             .collect();
         let kuc = internal_forces(model, &uc);
         for (g, v) in kuc.iter().enumerate() {

@@ -19,7 +19,10 @@ pub fn local_frame(p1: &[f64; 3], p2: &[f64; 3]) -> (Matrix3<f64>, f64) {
     aux[k] = 1.0;
     let e2 = (aux - e1 * e1.dot(&aux)).normalize();
     let e3 = e1.cross(&e2);
-    (Matrix3::from_rows(&[e1.transpose(), e2.transpose(), e3.transpose()]), length)
+    (
+        Matrix3::from_rows(&[e1.transpose(), e2.transpose(), e3.transpose()]),
+        length,
+    )
 }
 
 #[cfg(test)]
@@ -28,7 +31,13 @@ mod tests {
 
     #[test]
     fn orthonormal_right_handed_for_axis_aligned_and_oblique() {
-        for p2 in [[0.0, 0.0, 2.0], [0.0, 0.0, -1.0], [3.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, -2.0, 0.5]] {
+        for p2 in [
+            [0.0, 0.0, 2.0],
+            [0.0, 0.0, -1.0],
+            [3.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, -2.0, 0.5],
+        ] {
             let (r, l) = local_frame(&[0.0; 3], &p2);
             let n = (p2[0] * p2[0] + p2[1] * p2[1] + p2[2] * p2[2]).sqrt();
             assert!((l - n).abs() < 1e-15);

@@ -42,11 +42,20 @@ mod tests {
         let h0 = hermite(0.0, l);
         let hl = hermite(l, l);
         assert_eq!(h0, [1.0, 0.0, 0.0, 0.0]);
-        assert!((hl[2] - 1.0).abs() < 1e-15 && hl[0].abs() < 1e-15 && hl[1].abs() < 1e-15 && hl[3].abs() < 1e-15);
+        assert!(
+            (hl[2] - 1.0).abs() < 1e-15
+                && hl[0].abs() < 1e-15
+                && hl[1].abs() < 1e-15
+                && hl[3].abs() < 1e-15
+        );
         // Slopes by central differences: H2'(0) = 1, H4'(l) = 1, the others 0.
         let e = 1e-6;
-        let d0: Vec<f64> = (0..4).map(|k| (hermite(e, l)[k] - hermite(-e, l)[k]) / (2.0 * e)).collect();
-        let dl: Vec<f64> = (0..4).map(|k| (hermite(l + e, l)[k] - hermite(l - e, l)[k]) / (2.0 * e)).collect();
+        let d0: Vec<f64> = (0..4)
+            .map(|k| (hermite(e, l)[k] - hermite(-e, l)[k]) / (2.0 * e))
+            .collect();
+        let dl: Vec<f64> = (0..4)
+            .map(|k| (hermite(l + e, l)[k] - hermite(l - e, l)[k]) / (2.0 * e))
+            .collect();
         for (k, want) in [0.0, 1.0, 0.0, 0.0].iter().enumerate() {
             assert!((d0[k] - want).abs() < 1e-8);
         }

@@ -1,7 +1,9 @@
 //! A clamped square grid of straight fibers rigidly joined at their crossings — the structure
 //! of a geotextile without its periodic cell; used by tests, benches and the example fixture.
 
-use crate::model::{DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec};
+use crate::model::{
+    DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec,
+};
 
 /// `k`×`k` straight steel fibers (k along x, k along y, `spacing` apart) joined at their crossings,
 /// each edge split in `sub` elements, clamped along the x = 0 edge, loaded at the far corner.
@@ -16,7 +18,11 @@ pub fn clamped_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDes
             if i % sub == 0 || j % sub == 0 {
                 nodes.push(NodeSpec {
                     id: id(i, j),
-                    x: [i as f64 * h, j as f64 * h, 0.01 * ((i * 7 + j * 3) % 5) as f64 * h],
+                    x: [
+                        i as f64 * h,
+                        j as f64 * h,
+                        0.01 * ((i * 7 + j * 3) % 5) as f64 * h,
+                    ],
                 });
             }
         }
@@ -61,4 +67,3 @@ pub fn clamped_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDes
         }],
     }
 }
-

@@ -11,7 +11,9 @@
 //! where a node joins other than two of them.
 
 use super::InputError;
-use crate::model::{DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec};
+use crate::model::{
+    DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec,
+};
 use std::collections::{BTreeMap, HashMap};
 
 struct Section {
@@ -85,9 +87,12 @@ impl Reader {
     }
 
     fn id(&self, line: usize, s: &str, what: &str) -> Result<u64, InputError> {
-        s.trim()
-            .parse()
-            .map_err(|_| self.err(line, format!("{what}: \"{}\" is not a positive integer id", s.trim())))
+        s.trim().parse().map_err(|_| {
+            self.err(
+                line,
+                format!("{what}: \"{}\" is not a positive integer id", s.trim()),
+            )
+        })
     }
 
     fn dof(&self, line: usize, s: &str) -> Result<DofSet, InputError> {
@@ -115,24 +120,46 @@ impl Reader {
             .ok_or_else(|| self.err(line, format!("unknown node or node set \"{s}\"")))
     }
 
-    fn set_members(&self, line: usize, fields: &[&str], generate: bool) -> Result<Vec<u64>, InputError> {
-        let fields: Vec<&str> = fields.iter().copied().filter(|f| !f.trim().is_empty()).collect();
+    fn set_members(
+        &self,
+        line: usize,
+        fields: &[&str],
+        generate: bool,
+    ) -> Result<Vec<u64>, InputError> {
+        let fields: Vec<&str> = fields
+            .iter()
+            .copied()
+            .filter(|f| !f.trim().is_empty())
+            .collect();
         if generate {
             if fields.len() < 2 || fields.len() > 3 {
                 return Err(self.err(line, "GENERATE needs first, last[, increment]"));
             }
             let a = self.id(line, fields[0], "first")?;
             let b = self.id(line, fields[1], "last")?;
-            let inc = if fields.len() == 3 { self.id(line, fields[2], "increment")? } else { 1 };
+            let inc = if fields.len() == 3 {
+                self.id(line, fields[2], "increment")?
+            } else {
+                1
+            };
             if inc == 0 || b < a {
                 return Err(self.err(line, "GENERATE needs first ≤ last and a positive increment"));
             }
             return Ok((a..=b).step_by(inc as usize).collect());
         }
-        fields.iter().map(|f| self.id(line, f, "set member")).collect()
+        fields
+            .iter()
+            .map(|f| self.id(line, f, "set member"))
+            .collect()
     }
 
-    fn data_line(&mut self, block: Block, line: usize, fields: &[&str], ctx: &mut Context) -> Result<Block, InputError> {
+    fn data_line(
+        &mut self,
+        block: Block,
+        line: usize,
+        fields: &[&str],
+        ctx: &mut Context,
+    ) -> Result<Block, InputError> {
         let need = |n: usize, what: &str| -> Result<(), InputError> {
             if fields.iter().filter(|f| !f.trim().is_empty()).count() < n {
                 Err(self.err(line, format!("{what} needs at least {n} values")))
@@ -151,9 +178,9 @@ impl Reader {
                 need(3, "*NODE")?;
                 let id = self.id(line, fields[0], "node id")?;
                 let mut x = [0.0; 3];
-                for k in 0..3 {
-                    if let Some(f) = fields.get(k + 1).filter(|f| !f.trim().is_empty()) {
-                        x[k] = self.num(line, f, "coordinate")?;
+                for (xk, f) in x.iter_mut().zip(&fields[1..]) {
+                    if !f.trim().is_empty() {
+                        *xk = self.num(line, f, "coordinate")?;
                     }
                 }
                 self.nodes.push(NodeSpec { id, x });
@@ -162,15 +189,28 @@ impl Reader {
                 }
             }
             Block::Element => {
-                let f: Vec<&str> = fields.iter().copied().filter(|f| !f.trim().is_empty()).collect();
+                let f: Vec<&str> = fields
+                    .iter()
+                    .copied()
+                    .filter(|f| !f.trim().is_empty())
+                    .collect();
                 if f.len() != 3 {
-                    return Err(self.err(line, format!("two-node beam element needs id, node, node; found {} values", f.len())));
+                    return Err(self.err(
+                        line,
+                        format!(
+                            "two-node beam element needs id, node, node; found {} values",
+                            f.len()
+                        ),
+                    ));
                 }
                 let id = self.id(line, f[0], "element id")?;
                 let a = self.id(line, f[1], "node")?;
                 let b = self.id(line, f[2], "node")?;
                 if let Some(first) = self.element_line.insert(id, line) {
-                    return Err(self.err(line, format!("element {id} already defined on line {first}")));
+                    return Err(self.err(
+                        line,
+                        format!("element {id} already defined on line {first}"),
+                    ));
                 }
                 self.elements.push((id, a, b));
                 if let Some(set) = &ctx.elset {
@@ -209,7 +249,10 @@ impl Reader {
                 need(2, "*ELASTIC")?;
                 let e = self.num(line, fields[0], "E")?;
                 let nu = self.num(line, fields[1], "ν")?;
-                let name = ctx.material.clone().ok_or_else(|| self.err(line, "*ELASTIC outside a *MATERIAL"))?;
+                let name = ctx
+                    .material
+                    .clone()
+                    .ok_or_else(|| self.err(line, "*ELASTIC outside a *MATERIAL"))?;
                 self.materials.push(MaterialSpec {
                     name,
                     young: e,
@@ -240,12 +283,23 @@ impl Reader {
                             Some(f) => self.num(line, f, "prescribed value")?,
                             None => 0.0,
                         };
-                        let sets = [DofSet::Ux, DofSet::Uy, DofSet::Uz, DofSet::Rx, DofSet::Ry, DofSet::Rz];
+                        let sets = [
+                            DofSet::Ux,
+                            DofSet::Uy,
+                            DofSet::Uz,
+                            DofSet::Rx,
+                            DofSet::Ry,
+                            DofSet::Rz,
+                        ];
                         (sets[a..=b].to_vec(), value)
                     }
                 };
                 for node in targets {
-                    self.supports.push(SupportSpec { node, dofs: dofs.clone(), value });
+                    self.supports.push(SupportSpec {
+                        node,
+                        dofs: dofs.clone(),
+                        value,
+                    });
                 }
             }
             Block::Cload => {
@@ -254,7 +308,11 @@ impl Reader {
                 let k = self.dof(line, fields[1])?.dofs()[0].index();
                 let v = self.num(line, fields[2], "load")?;
                 for node in targets {
-                    let mut l = LoadSpec { node, force: [0.0; 3], moment: [0.0; 3] };
+                    let mut l = LoadSpec {
+                        node,
+                        force: [0.0; 3],
+                        moment: [0.0; 3],
+                    };
                     if k < 3 {
                         l.force[k] = v;
                     } else {
@@ -284,28 +342,54 @@ impl Reader {
                 Block::Node
             }
             "ELEMENT" => {
-                let ty = p.get("TYPE").map(|t| t.to_ascii_uppercase()).unwrap_or_default();
+                let ty = p
+                    .get("TYPE")
+                    .map(|t| t.to_ascii_uppercase())
+                    .unwrap_or_default();
                 if ty != "B31" && ty != "B33" {
-                    return Err(self.err(line, format!("element TYPE={ty} is not supported (only B31 and B33 two-node beams)")));
+                    return Err(self.err(
+                        line,
+                        format!(
+                            "element TYPE={ty} is not supported (only B31 and B33 two-node beams)"
+                        ),
+                    ));
                 }
                 ctx.elset = p.get("ELSET").map(|s| s.to_ascii_uppercase());
                 Block::Element
             }
             "NSET" => {
-                ctx.nset = Some(p.get("NSET").ok_or_else(|| self.err(line, "*NSET needs NSET="))?.to_ascii_uppercase());
+                ctx.nset = Some(
+                    p.get("NSET")
+                        .ok_or_else(|| self.err(line, "*NSET needs NSET="))?
+                        .to_ascii_uppercase(),
+                );
                 Block::Nset { generate }
             }
             "ELSET" => {
-                ctx.elset = Some(p.get("ELSET").ok_or_else(|| self.err(line, "*ELSET needs ELSET="))?.to_ascii_uppercase());
+                ctx.elset = Some(
+                    p.get("ELSET")
+                        .ok_or_else(|| self.err(line, "*ELSET needs ELSET="))?
+                        .to_ascii_uppercase(),
+                );
                 Block::Elset { generate }
             }
             "BEAM SECTION" => {
-                let sec = p.get("SECTION").map(|s| s.to_ascii_uppercase()).unwrap_or_default();
+                let sec = p
+                    .get("SECTION")
+                    .map(|s| s.to_ascii_uppercase())
+                    .unwrap_or_default();
                 if sec != "CIRC" {
-                    return Err(self.err(line, format!("*BEAM SECTION, SECTION={sec} is not supported (only CIRC)")));
+                    return Err(self.err(
+                        line,
+                        format!("*BEAM SECTION, SECTION={sec} is not supported (only CIRC)"),
+                    ));
                 }
-                let elset = p.get("ELSET").ok_or_else(|| self.err(line, "*BEAM SECTION needs ELSET="))?;
-                let material = p.get("MATERIAL").ok_or_else(|| self.err(line, "*BEAM SECTION needs MATERIAL="))?;
+                let elset = p
+                    .get("ELSET")
+                    .ok_or_else(|| self.err(line, "*BEAM SECTION needs ELSET="))?;
+                let material = p
+                    .get("MATERIAL")
+                    .ok_or_else(|| self.err(line, "*BEAM SECTION needs MATERIAL="))?;
                 self.sections.push(Section {
                     elset: elset.to_ascii_uppercase(),
                     material: material.to_ascii_uppercase(),
@@ -315,13 +399,20 @@ impl Reader {
                 Block::BeamSection
             }
             "MATERIAL" => {
-                ctx.material = Some(p.get("NAME").ok_or_else(|| self.err(line, "*MATERIAL needs NAME="))?.to_ascii_uppercase());
+                ctx.material = Some(
+                    p.get("NAME")
+                        .ok_or_else(|| self.err(line, "*MATERIAL needs NAME="))?
+                        .to_ascii_uppercase(),
+                );
                 Block::None
             }
             "ELASTIC" => {
                 if let Some(t) = p.get("TYPE") {
                     if !t.eq_ignore_ascii_case("ISOTROPIC") {
-                        return Err(self.err(line, format!("*ELASTIC, TYPE={t} is not supported (only ISOTROPIC)")));
+                        return Err(self.err(
+                            line,
+                            format!("*ELASTIC, TYPE={t} is not supported (only ISOTROPIC)"),
+                        ));
                     }
                 }
                 Block::Elastic
@@ -395,7 +486,9 @@ fn chain(elements: &[(u64, u64, u64)]) -> Vec<(u64, Vec<u64>)> {
             continue;
         }
         let (id, a, b) = elements[k];
-        let end = [a, b].into_iter().find(|n| at.get(n).is_some_and(|v| v.len() != 2));
+        let end = [a, b]
+            .into_iter()
+            .find(|n| at.get(n).is_some_and(|v| v.len() != 2));
         if let Some(start) = end {
             out.push((id, walk(k, start, &mut used)));
         }
@@ -430,35 +523,67 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
             block = r.data_line(block, line, &fields, &mut ctx)?;
         }
     }
-    let path_err = |line: usize, m: String| InputError::Syntax { path: path.into(), line, column: 1, message: m };
+    let path_err = |line: usize, m: String| InputError::Syntax {
+        path: path.into(),
+        line,
+        column: 1,
+        message: m,
+    };
     // Sections → fibers.
     let by_id: HashMap<u64, (u64, u64, u64)> = r.elements.iter().map(|e| (e.0, *e)).collect();
     let mut owner: HashMap<u64, usize> = HashMap::new();
     let mut fibers = Vec::new();
     let materials: HashMap<String, ()> = r.materials.iter().map(|m| (m.name.clone(), ())).collect();
     for (si, s) in r.sections.iter().enumerate() {
-        let radius = s.radius.ok_or_else(|| path_err(s.line, "*BEAM SECTION has no data line with the radius".into()))?;
+        let radius = s.radius.ok_or_else(|| {
+            path_err(
+                s.line,
+                "*BEAM SECTION has no data line with the radius".into(),
+            )
+        })?;
         if !materials.contains_key(&s.material) {
-            return Err(path_err(s.line, format!("*BEAM SECTION refers to unknown material {}", s.material)));
+            return Err(path_err(
+                s.line,
+                format!("*BEAM SECTION refers to unknown material {}", s.material),
+            ));
         }
-        let members = r.elsets.get(&s.elset).ok_or_else(|| path_err(s.line, format!("unknown element set {}", s.elset)))?;
+        let members = r
+            .elsets
+            .get(&s.elset)
+            .ok_or_else(|| path_err(s.line, format!("unknown element set {}", s.elset)))?;
         let mut els = Vec::with_capacity(members.len());
         for id in members {
-            let e = by_id.get(id).ok_or_else(|| path_err(s.line, format!("element set {} contains unknown element {id}", s.elset)))?;
+            let e = by_id.get(id).ok_or_else(|| {
+                path_err(
+                    s.line,
+                    format!("element set {} contains unknown element {id}", s.elset),
+                )
+            })?;
             if let Some(prev) = owner.insert(*id, si) {
                 if prev != si {
-                    return Err(path_err(s.line, format!("element {id} has two beam sections")));
+                    return Err(path_err(
+                        s.line,
+                        format!("element {id} has two beam sections"),
+                    ));
                 }
                 continue;
             }
             els.push(*e);
         }
         for (id, nodes) in chain(&els) {
-            fibers.push(FiberSpec { id, nodes, radius, material: s.material.clone() });
+            fibers.push(FiberSpec {
+                id,
+                nodes,
+                radius,
+                material: s.material.clone(),
+            });
         }
     }
     if let Some(&(id, _, _)) = r.elements.iter().find(|e| !owner.contains_key(&e.0)) {
-        return Err(path_err(r.element_line[&id], format!("element {id} has no *BEAM SECTION")));
+        return Err(path_err(
+            r.element_line[&id],
+            format!("element {id} has no *BEAM SECTION"),
+        ));
     }
     Ok(ModelDescription {
         name: r.name,
@@ -477,7 +602,15 @@ mod tests {
     #[test]
     fn chains_split_at_junctions_and_close_loops() {
         // 1-2-3 and 3-4 and 3-5 (junction at 3), plus a triangle loop 10-11-12.
-        let els = [(1, 1, 2), (2, 2, 3), (3, 3, 4), (4, 5, 3), (5, 10, 11), (6, 11, 12), (7, 12, 10)];
+        let els = [
+            (1, 1, 2),
+            (2, 2, 3),
+            (3, 3, 4),
+            (4, 5, 3),
+            (5, 10, 11),
+            (6, 11, 12),
+            (7, 12, 10),
+        ];
         let c = chain(&els);
         assert_eq!(c[0], (1, vec![1, 2, 3]));
         assert_eq!(c[1], (3, vec![3, 4]));

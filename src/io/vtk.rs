@@ -18,10 +18,22 @@ pub fn deformed_vtu(model: &Model, sol: &StaticSolution) -> String {
     }
     let mut s = String::with_capacity(200 * n + 100 * els.len());
     s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n");
-    let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">", els.len());
-    s.push_str("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    let _ = writeln!(
+        s,
+        "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">",
+        els.len()
+    );
+    s.push_str(
+        "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
+    );
     for (nd, u) in model.nodes.iter().zip(&sol.displacements) {
-        let _ = writeln!(s, "{:e} {:e} {:e}", nd.x[0] + u[0], nd.x[1] + u[1], nd.x[2] + u[2]);
+        let _ = writeln!(
+            s,
+            "{:e} {:e} {:e}",
+            nd.x[0] + u[0],
+            nd.x[1] + u[1],
+            nd.x[2] + u[2]
+        );
     }
     s.push_str("</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
     for e in els {

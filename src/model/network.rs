@@ -120,7 +120,10 @@ impl Model {
         let mut materials = Vec::with_capacity(d.materials.len());
         let mut material_index = HashMap::new();
         for m in &d.materials {
-            if material_index.insert(m.name.clone(), materials.len()).is_some() {
+            if material_index
+                .insert(m.name.clone(), materials.len())
+                .is_some()
+            {
                 return Err(ModelError::DuplicateMaterial(m.name.clone()));
             }
             materials.push(check_material(m)?);
@@ -140,19 +143,25 @@ impl Model {
             nodes.push(Node { id: n.id, x: n.x });
         }
         let lookup = |id: u64, referrer: &dyn Fn() -> String| {
-            node_index.get(&id).copied().ok_or_else(|| ModelError::UnknownNode {
-                node: id,
-                referrer: referrer(),
-            })
+            node_index
+                .get(&id)
+                .copied()
+                .ok_or_else(|| ModelError::UnknownNode {
+                    node: id,
+                    referrer: referrer(),
+                })
         };
         // Length scale for "zero length": the bounding box diagonal.
-        let (lo, hi) = nodes.iter().fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), n| {
-            (
-                [lo[0].min(n.x[0]), lo[1].min(n.x[1]), lo[2].min(n.x[2])],
-                [hi[0].max(n.x[0]), hi[1].max(n.x[1]), hi[2].max(n.x[2])],
-            )
-        });
-        let diag = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+        let (lo, hi) = nodes
+            .iter()
+            .fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), n| {
+                (
+                    [lo[0].min(n.x[0]), lo[1].min(n.x[1]), lo[2].min(n.x[2])],
+                    [hi[0].max(n.x[0]), hi[1].max(n.x[1]), hi[2].max(n.x[2])],
+                )
+            });
+        let diag =
+            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
         let min_length = 1e-12 * diag.max(f64::MIN_POSITIVE);
 
         let mut fibers = Vec::with_capacity(d.fibers.len());
@@ -173,10 +182,13 @@ impl Model {
                     radius: f.radius,
                 });
             }
-            let material = *material_index.get(&f.material).ok_or_else(|| ModelError::UnknownMaterial {
-                fiber: f.id,
-                material: f.material.clone(),
-            })?;
+            let material =
+                *material_index
+                    .get(&f.material)
+                    .ok_or_else(|| ModelError::UnknownMaterial {
+                        fiber: f.id,
+                        material: f.material.clone(),
+                    })?;
             let idx = f
                 .nodes
                 .iter()
@@ -184,7 +196,9 @@ impl Model {
                 .collect::<Result<Vec<_>, _>>()?;
             for w in idx.windows(2) {
                 let (a, b) = (w[0], w[1]);
-                let l2: f64 = (0..3).map(|k| (nodes[b].x[k] - nodes[a].x[k]).powi(2)).sum();
+                let l2: f64 = (0..3)
+                    .map(|k| (nodes[b].x[k] - nodes[a].x[k]).powi(2))
+                    .sum();
                 if l2.sqrt() <= min_length {
                     return Err(ModelError::ZeroLengthElement {
                         fiber: f.id,
@@ -339,10 +353,18 @@ impl Model {
                     name: m.name.clone(),
                     young: m.young,
                     poisson: m.poisson,
-                    shear: if m.poisson.is_some() { None } else { Some(m.shear) },
+                    shear: if m.poisson.is_some() {
+                        None
+                    } else {
+                        Some(m.shear)
+                    },
                 })
                 .collect(),
-            nodes: self.nodes.iter().map(|n| NodeSpec { id: n.id, x: n.x }).collect(),
+            nodes: self
+                .nodes
+                .iter()
+                .map(|n| NodeSpec { id: n.id, x: n.x })
+                .collect(),
             fibers: self
                 .fibers
                 .iter()

@@ -56,7 +56,9 @@ impl FromStr for SolverKind {
         SolverKind::ALL
             .into_iter()
             .find(|k| k.name() == s)
-            .ok_or_else(|| format!("unknown solver \"{s}\" (use faer-cholesky, faer-lu, cg or cholmod)"))
+            .ok_or_else(|| {
+                format!("unknown solver \"{s}\" (use faer-cholesky, faer-lu, cg or cholmod)")
+            })
     }
 }
 

@@ -114,7 +114,11 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
         Vec::new()
     } else {
         let a = sys.matrix()?;
-        let mut solver = make_solver(options.solver, &options.ordering, sys.dofs.node_block_starts())?;
+        let mut solver = make_solver(
+            options.solver,
+            &options.ordering,
+            sys.dofs.node_block_starts(),
+        )?;
         let t = Instant::now();
         let info = solver.analyze(a).map_err(|e| locate(e, model, &sys))?;
         timings.analyze = t.elapsed().as_secs_f64();
@@ -131,8 +135,11 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
             }
             let mut r = vec![0.0; n];
             a.mul_vec(&x, &mut r);
-            r.iter_mut().zip(&sys.rhs).for_each(|(ri, bi)| *ri = bi - *ri);
-            let (dx, _) = solve_checked(solver.as_mut(), a, &r, 1).map_err(|e| locate(e, model, &sys))?;
+            r.iter_mut()
+                .zip(&sys.rhs)
+                .for_each(|(ri, bi)| *ri = bi - *ri);
+            let (dx, _) =
+                solve_checked(solver.as_mut(), a, &r, 1).map_err(|e| locate(e, model, &sys))?;
             let refined: Vec<f64> = x.iter().zip(&dx).map(|(p, q)| p + q).collect();
             let res = fibercell_solver::relative_residual(a, &refined, &sys.rhs);
             if !(res < report.relative_residual) {
@@ -143,7 +150,11 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
             report.backward_error = fibercell_solver::backward_error(a, &x, &sys.rhs);
         }
         timings.solve = t.elapsed().as_secs_f64();
-        let tol = if options.max_backward_error > 0.0 { options.max_backward_error } else { 1e-10 };
+        let tol = if options.max_backward_error > 0.0 {
+            options.max_backward_error
+        } else {
+            1e-10
+        };
         if !(report.backward_error <= tol) {
             return Err(Error::Solver(SolverError::Singular {
                 column: None,
@@ -164,7 +175,10 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
     let u = sys.dofs.expand(&reduced);
     summary.timings = timings;
     Ok(StaticSolution {
-        displacements: u.chunks(6).map(|c| [c[0], c[1], c[2], c[3], c[4], c[5]]).collect(),
+        displacements: u
+            .chunks(6)
+            .map(|c| [c[0], c[1], c[2], c[3], c[4], c[5]])
+            .collect(),
         reactions: reactions(model, &sys.dofs, &u),
         summary,
     })

@@ -1,7 +1,9 @@
 //! Helpers shared by the integration tests: small model builders.
 #![allow(dead_code)]
 
-use fibercell::model::{DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec};
+use fibercell::model::{
+    DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec,
+};
 use fibercell::Model;
 
 pub const E: f64 = 2.1e11;
@@ -18,13 +20,24 @@ pub fn steel() -> MaterialSpec {
 
 /// A straight fiber from `a` to `b` in `n` elements, clamped at `a`, with a tip force and
 /// moment at `b`. Node ids 1..=n+1 from a to b.
-pub fn cantilever(a: [f64; 3], b: [f64; 3], n: usize, radius: f64, force: [f64; 3], moment: [f64; 3]) -> ModelDescription {
+pub fn cantilever(
+    a: [f64; 3],
+    b: [f64; 3],
+    n: usize,
+    radius: f64,
+    force: [f64; 3],
+    moment: [f64; 3],
+) -> ModelDescription {
     let nodes: Vec<NodeSpec> = (0..=n)
         .map(|k| {
             let t = k as f64 / n as f64;
             NodeSpec {
                 id: k as u64 + 1,
-                x: [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])],
+                x: [
+                    a[0] + t * (b[0] - a[0]),
+                    a[1] + t * (b[1] - a[1]),
+                    a[2] + t * (b[2] - a[2]),
+                ],
             }
         })
         .collect();
@@ -76,9 +89,19 @@ fn d2_hermite(s: f64, l: f64) -> [f64; 4] {
 
 /// k = ∫ Bᵀ D B ds (4.34) by 3-point Gauss–Legendre quadrature (exact for these quadratic
 /// integrands), local DOF order u v w θx θy θz per node, θz = v′, θy = −w′.
-pub fn quadrature_local_stiffness(ea: f64, ei2: f64, ei3: f64, gj: f64, l: f64) -> nalgebra::DMatrix<f64> {
+pub fn quadrature_local_stiffness(
+    ea: f64,
+    ei2: f64,
+    ei3: f64,
+    gj: f64,
+    l: f64,
+) -> nalgebra::DMatrix<f64> {
     use nalgebra::{DMatrix, DVector};
-    let gauss = [(-(0.6f64).sqrt(), 5.0 / 9.0), (0.0, 8.0 / 9.0), ((0.6f64).sqrt(), 5.0 / 9.0)];
+    let gauss = [
+        (-(0.6f64).sqrt(), 5.0 / 9.0),
+        (0.0, 8.0 / 9.0),
+        ((0.6f64).sqrt(), 5.0 / 9.0),
+    ];
     let d = DMatrix::from_diagonal(&DVector::from_vec(vec![ea, ei3, ei2, gj]));
     let mut k = DMatrix::<f64>::zeros(12, 12);
     for (xi, w) in gauss {

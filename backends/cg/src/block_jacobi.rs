@@ -77,25 +77,29 @@ impl BlockJacobi {
             parts.push(head);
             rest = tail;
         }
-        parts.into_par_iter().with_min_len(256).enumerate().for_each(|(k, zk)| {
-            let (s, e) = bounds[k];
-            let b = e - s;
-            let l = &self.factors[self.offsets[k]..self.offsets[k + 1]];
-            // Forward then backward substitution with L and Lᵀ.
-            for i in 0..b {
-                let mut v = r[s + i];
-                for q in 0..i {
-                    v -= l[i * b + q] * zk[q];
+        parts
+            .into_par_iter()
+            .with_min_len(256)
+            .enumerate()
+            .for_each(|(k, zk)| {
+                let (s, e) = bounds[k];
+                let b = e - s;
+                let l = &self.factors[self.offsets[k]..self.offsets[k + 1]];
+                // Forward then backward substitution with L and Lᵀ.
+                for i in 0..b {
+                    let mut v = r[s + i];
+                    for q in 0..i {
+                        v -= l[i * b + q] * zk[q];
+                    }
+                    zk[i] = v / l[i * b + i];
                 }
-                zk[i] = v / l[i * b + i];
-            }
-            for i in (0..b).rev() {
-                let mut v = zk[i];
-                for q in i + 1..b {
-                    v -= l[q * b + i] * zk[q];
+                for i in (0..b).rev() {
+                    let mut v = zk[i];
+                    for q in i + 1..b {
+                        v -= l[q * b + i] * zk[q];
+                    }
+                    zk[i] = v / l[i * b + i];
                 }
-                zk[i] = v / l[i * b + i];
-            }
-        });
+            });
     }
 }

@@ -68,7 +68,9 @@ impl ConjugateGradient {
     fn starts(&self, n: usize) -> Result<Vec<usize>, SolverError> {
         match &self.block_starts {
             Some(s) => {
-                let ok = s.first() == Some(&0) && s.windows(2).all(|w| w[0] < w[1]) && s.last().is_some_and(|&l| l < n.max(1));
+                let ok = s.first() == Some(&0)
+                    && s.windows(2).all(|w| w[0] < w[1])
+                    && s.last().is_some_and(|&l| l < n.max(1));
                 if ok || (n == 0 && s.is_empty()) {
                     Ok(s.clone())
                 } else {
@@ -82,7 +84,15 @@ impl ConjugateGradient {
     }
 
     /// PCG from the current `x` on the true residual b − A x; returns (iterations, reason).
-    fn pcg_pass(&self, a: CscRef<'_>, pre: &BlockJacobi, b: &[f64], x: &mut [f64], bnorm: f64, budget: usize) -> (usize, StopReason) {
+    fn pcg_pass(
+        &self,
+        a: CscRef<'_>,
+        pre: &BlockJacobi,
+        b: &[f64],
+        x: &mut [f64],
+        bnorm: f64,
+        budget: usize,
+    ) -> (usize, StopReason) {
         let n = b.len();
         let mut r = vec![0.0; n];
         a.mul_vec_symmetric_par(x, &mut r);
@@ -110,12 +120,16 @@ impl ConjugateGradient {
             }
             let alpha = rz / pap;
             x.iter_mut().zip(&p).for_each(|(xi, pi)| *xi += alpha * pi);
-            r.iter_mut().zip(&ap).for_each(|(ri, api)| *ri -= alpha * api);
+            r.iter_mut()
+                .zip(&ap)
+                .for_each(|(ri, api)| *ri -= alpha * api);
             pre.apply(&r, &mut z);
             let rz_new = dot(&r, &z);
             let beta = rz_new / rz;
             rz = rz_new;
-            p.iter_mut().zip(&z).for_each(|(pi, zi)| *pi = zi + beta * *pi);
+            p.iter_mut()
+                .zip(&z)
+                .for_each(|(pi, zi)| *pi = zi + beta * *pi);
             it += 1;
         }
     }
@@ -124,7 +138,12 @@ impl ConjugateGradient {
     /// precision, so after convergence the true residual is recomputed and CG restarted from
     /// the current iterate (residual replacement) while that still gains accuracy. Returns
     /// (iterations, true relative residual, reason).
-    fn solve_one(&self, a: CscRef<'_>, pre: &BlockJacobi, b: &mut [f64]) -> (usize, f64, StopReason) {
+    fn solve_one(
+        &self,
+        a: CscRef<'_>,
+        pre: &BlockJacobi,
+        b: &mut [f64],
+    ) -> (usize, f64, StopReason) {
         let n = b.len();
         let bnorm = norm(b);
         if bnorm == 0.0 {
@@ -143,7 +162,13 @@ impl ConjugateGradient {
             reason = why;
             let mut r = vec![0.0; n];
             a.mul_vec_symmetric_par(&x, &mut r);
-            let true_rel = r.iter().zip(b.iter()).map(|(p, q)| (q - p) * (q - p)).sum::<f64>().sqrt() / bnorm;
+            let true_rel = r
+                .iter()
+                .zip(b.iter())
+                .map(|(p, q)| (q - p) * (q - p))
+                .sum::<f64>()
+                .sqrt()
+                / bnorm;
             let gained = true_rel < 0.5 * best;
             if true_rel < best {
                 best = true_rel;
@@ -195,7 +220,9 @@ impl LinearSolver for ConjugateGradient {
     }
 
     fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError> {
-        let fp = self.pattern.ok_or(SolverError::OutOfOrder("factorize", "analyze"))?;
+        let fp = self
+            .pattern
+            .ok_or(SolverError::OutOfOrder("factorize", "analyze"))?;
         <dyn LinearSolver>::check_matrix(a, None)?;
         if a.fingerprint() != fp {
             return Err(SolverError::PatternChanged);
@@ -216,7 +243,10 @@ impl LinearSolver for ConjugateGradient {
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError> {
-        let (m, pre) = self.state.as_ref().ok_or(SolverError::OutOfOrder("solve", "factorize"))?;
+        let (m, pre) = self
+            .state
+            .as_ref()
+            .ok_or(SolverError::OutOfOrder("solve", "factorize"))?;
         let a = m.as_ref();
         let n = a.ncols();
         <dyn LinearSolver>::check_rhs(n, rhs, nrhs)?;

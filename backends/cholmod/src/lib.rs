@@ -174,7 +174,10 @@ impl LinearSolver for Cholmod {
             factor: std::ptr::null_mut(),
             factorized: false,
         };
-        let common = self.common.as_mut().ok_or(SolverError::OutOfOrder("analyze", "start"))?;
+        let common = self
+            .common
+            .as_mut()
+            .ok_or(SolverError::OutOfOrder("analyze", "start"))?;
         let c = common.as_mut_ptr();
         let mut header = state.header();
         // SAFETY: `c` is a started common; the header points to live arrays of the declared
@@ -183,7 +186,9 @@ impl LinearSolver for Cholmod {
             (*c).nmethods = nmethods;
             (*c).method[0].ordering = method as c_int;
             (*c).postorder = 1;
-            let pp = perm.as_mut().map_or(std::ptr::null_mut(), |p| p.as_mut_ptr());
+            let pp = perm
+                .as_mut()
+                .map_or(std::ptr::null_mut(), |p| p.as_mut_ptr());
             let f = ss::cholmod_l_analyze_p(&mut header, pp, std::ptr::null_mut(), 0, c);
             (f, (*c).status, (*c).lnz, (*c).fl)
         };
@@ -220,7 +225,10 @@ impl LinearSolver for Cholmod {
                 0.0
             };
             if !(ajj > 0.0) {
-                return Err(SolverError::NotPositiveDefinite { column: j, pivot: ajj });
+                return Err(SolverError::NotPositiveDefinite {
+                    column: j,
+                    pivot: ajj,
+                });
             }
             s.scale[j] = 1.0 / ajj.sqrt();
         }
@@ -256,7 +264,9 @@ impl LinearSolver for Cholmod {
         if !(rcond > tol) {
             return Err(SolverError::Singular {
                 column: None,
-                detail: format!("CHOLMOD reciprocal condition estimate {rcond:.3e} of the scaled matrix"),
+                detail: format!(
+                    "CHOLMOD reciprocal condition estimate {rcond:.3e} of the scaled matrix"
+                ),
             });
         }
         s.factorized = true;

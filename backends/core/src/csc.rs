@@ -72,9 +72,7 @@ fn check_structure(
                 return bad(format!("row index {r} out of range in column {j}"));
             }
             if k > 0 && rows[k - 1] >= r {
-                return bad(format!(
-                    "row indices not strictly increasing in column {j}"
-                ));
+                return bad(format!("row indices not strictly increasing in column {j}"));
             }
         }
     }
@@ -200,8 +198,7 @@ impl<'a> CscRef<'a> {
     /// y = A x, serial.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         y.iter_mut().for_each(|v| *v = 0.0);
-        for j in 0..self.ncols {
-            let xj = x[j];
+        for (j, &xj) in x.iter().enumerate().take(self.ncols) {
             let (rows, vals) = self.col(j);
             for (&i, &v) in rows.iter().zip(vals) {
                 y[i] += v * xj;
@@ -289,11 +286,7 @@ impl CscMatrix {
 
     /// Copies any sprs matrix (CSR or CSC, sliced or not) into CSC form.
     pub fn from_sprs(m: CsMatView<'_, f64>) -> Result<Self, SolverError> {
-        let csc = if m.is_csc() {
-            m.to_owned()
-        } else {
-            m.to_csc()
-        };
+        let csc = if m.is_csc() { m.to_owned() } else { m.to_csc() };
         let col_ptr = csc.indptr().to_proper().into_owned();
         let base = col_ptr.first().copied().unwrap_or(0);
         let col_ptr: Vec<usize> = col_ptr.iter().map(|p| p - base).collect();
@@ -362,7 +355,10 @@ mod tests {
     #[test]
     fn rejects_unsorted_rows_and_bad_pointers() {
         let e = CscRef::new(2, 2, &[0, 2, 3], &[1, 0, 1], &[1.0, 2.0, 3.0]).unwrap_err();
-        assert!(e.to_string().contains("strictly increasing in column 0"), "{e}");
+        assert!(
+            e.to_string().contains("strictly increasing in column 0"),
+            "{e}"
+        );
         let e = CscRef::new(2, 2, &[0, 2], &[0, 1], &[1.0, 2.0]).unwrap_err();
         assert!(e.to_string().contains("ncols + 1"), "{e}");
         let e = CscRef::new(2, 2, &[0, 1, 2], &[0, 5], &[1.0, 2.0]).unwrap_err();
@@ -374,7 +370,14 @@ mod tests {
         let a = CscMatrix::from_triplets(
             3,
             3,
-            &[(0, 0, 4.0), (1, 0, 1.0), (0, 1, 1.0), (1, 1, 3.0), (2, 2, 2.0), (2, 2, 0.5)],
+            &[
+                (0, 0, 4.0),
+                (1, 0, 1.0),
+                (0, 1, 1.0),
+                (1, 1, 3.0),
+                (2, 2, 2.0),
+                (2, 2, 0.5),
+            ],
         )
         .unwrap();
         let s = a.to_sprs();

@@ -117,12 +117,12 @@ fn supervariables(a: CscRef<'_>) -> (Vec<usize>, Vec<usize>) {
     let n = a.ncols();
     let mut group = vec![0usize; n];
     let mut starts = Vec::new();
-    for j in 0..n {
+    for (j, g) in group.iter_mut().enumerate() {
         let same = j > 0 && a.col(j).0 == a.col(j - 1).0;
         if !same {
             starts.push(j);
         }
-        group[j] = starts.len() - 1;
+        *g = starts.len() - 1;
     }
     (group, starts)
 }
@@ -254,7 +254,10 @@ mod tests {
     #[test]
     fn given_ordering_is_checked() {
         let a = grid_laplacian(3, 1);
-        let e = compute_ordering(a.as_ref(), &Ordering::Given(vec![0, 1, 1, 3, 4, 5, 6, 7, 8]));
+        let e = compute_ordering(
+            a.as_ref(),
+            &Ordering::Given(vec![0, 1, 1, 3, 4, 5, 6, 7, 8]),
+        );
         assert!(matches!(e, Err(SolverError::InvalidMatrix(_))));
         let e = compute_ordering(a.as_ref(), &Ordering::Given(vec![0]));
         assert!(matches!(e, Err(SolverError::DimensionMismatch(_))));

@@ -20,7 +20,12 @@ pub struct SolveReport {
 pub fn relative_residual(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
     let mut ax = vec![0.0; a.nrows()];
     a.mul_vec(x, &mut ax);
-    let r: f64 = ax.iter().zip(b).map(|(p, q)| (p - q) * (p - q)).sum::<f64>().sqrt();
+    let r: f64 = ax
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (p - q) * (p - q))
+        .sum::<f64>()
+        .sqrt();
     let nb: f64 = b.iter().map(|v| v * v).sum::<f64>().sqrt();
     if nb > 0.0 {
         r / nb
@@ -33,7 +38,10 @@ pub fn relative_residual(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
 pub fn backward_error(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
     let mut ax = vec![0.0; a.nrows()];
     a.mul_vec(x, &mut ax);
-    let r = ax.iter().zip(b).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+    let r = ax
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
     let mut row_sums = vec![0.0; a.nrows()];
     for (&i, v) in a.row_idx().iter().zip(a.values()) {
         row_sums[i] += v.abs();

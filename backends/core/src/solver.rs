@@ -58,7 +58,6 @@ pub trait LinearSolver: Send {
     fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError>;
 }
 
-
 impl dyn LinearSolver {
     /// Checks that `rhs` holds `nrhs` columns of length `n`.
     pub fn check_rhs(n: usize, rhs: &[f64], nrhs: usize) -> Result<(), SolverError> {

@@ -150,12 +150,16 @@ impl LinearSolver for FaerCholesky {
             }
             lower_col_ptr.push(lower_row_idx.len());
         }
-        let lower = SymbolicSparseColMatRef::new_checked(n, n, &lower_col_ptr, None, &lower_row_idx);
+        let lower =
+            SymbolicSparseColMatRef::new_checked(n, n, &lower_col_ptr, None, &lower_row_idx);
         let (perm, symbolic, name) = match &self.ordering {
             Ordering::Auto => {
                 // Both candidates, keep the one with fewer predicted flops.
                 let mut best: Option<(Permutation, SymbolicCholesky<usize>, f64, &str)> = None;
-                for (o, nm) in [(Ordering::Amd, "auto→amd"), (Ordering::NestedDissection, "auto→nested-dissection")] {
+                for (o, nm) in [
+                    (Ordering::Amd, "auto→amd"),
+                    (Ordering::NestedDissection, "auto→nested-dissection"),
+                ] {
                     let p = compute_ordering(a, &o)?;
                     let s = self.symbolic_for(lower, &p)?;
                     let flops = fill_and_flops(&s).1;
@@ -212,7 +216,14 @@ impl LinearSolver for FaerCholesky {
             let d = an.lower_src[an.lower_col_ptr[j]];
             let ajj = a.values()[d];
             if an.lower_row_idx[an.lower_col_ptr[j]] != j || !(ajj > 0.0) {
-                return Err(pivot_error(j, if an.lower_row_idx[an.lower_col_ptr[j]] == j { ajj } else { 0.0 }));
+                return Err(pivot_error(
+                    j,
+                    if an.lower_row_idx[an.lower_col_ptr[j]] == j {
+                        ajj
+                    } else {
+                        0.0
+                    },
+                ));
             }
             f.scale[j] = 1.0 / ajj.sqrt();
         }
@@ -228,7 +239,11 @@ impl LinearSolver for FaerCholesky {
         );
         let sym = &an.symbolic;
         let first_pivot_index = |index: usize| {
-            let k = if is_simplicial(sym) { index.saturating_sub(1) } else { index };
+            let k = if is_simplicial(sym) {
+                index.saturating_sub(1)
+            } else {
+                index
+            };
             an.perm.fwd[k.min(n - 1)]
         };
         match self.variant {

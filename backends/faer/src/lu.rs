@@ -5,13 +5,14 @@
 //! reported [`SolverError::Singular`].
 
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu};
+use faer::sparse::linalg::lu::{
+    factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
+};
 use faer::sparse::linalg::LuError;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Spec};
 use fibercell_solver::{
-    AnalyzeInfo, Capabilities, CscRef, LinearSolver, PatternFingerprint, SolveInfo,
-    SolverError,
+    AnalyzeInfo, Capabilities, CscRef, LinearSolver, PatternFingerprint, SolveInfo, SolverError,
 };
 
 /// faer sparse LU for general square matrices.
@@ -83,13 +84,14 @@ impl LinearSolver for FaerLu {
         self.numeric = None;
         let n = a.ncols();
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
-        let symbolic = factorize_symbolic_lu(pattern, LuSymbolicParams::default()).map_err(|e| {
-            SolverError::Backend {
-                backend: "faer-lu",
-                code: -1,
-                message: format!("symbolic LU failed: {e:?}"),
-            }
-        })?;
+        let symbolic =
+            factorize_symbolic_lu(pattern, LuSymbolicParams::default()).map_err(|e| {
+                SolverError::Backend {
+                    backend: "faer-lu",
+                    code: -1,
+                    message: format!("symbolic LU failed: {e:?}"),
+                }
+            })?;
         self.analysis = Some((n, a.fingerprint(), symbolic));
         Ok(AnalyzeInfo {
             n,
@@ -117,7 +119,13 @@ impl LinearSolver for FaerLu {
             SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx()),
             a.values(),
         );
-        match symbolic.factorize_numeric_lu(&mut numeric, mat, self.par, MemStack::new(&mut buf), Spec::default()) {
+        match symbolic.factorize_numeric_lu(
+            &mut numeric,
+            mat,
+            self.par,
+            MemStack::new(&mut buf),
+            Spec::default(),
+        ) {
             Ok(_) => {}
             Err(LuError::SymbolicSingular { index }) => {
                 return Err(SolverError::Singular {
@@ -139,12 +147,20 @@ impl LinearSolver for FaerLu {
         let mut b = vec![0.0; n];
         a.mul_vec(&ones, &mut b);
         self.solve_raw(&mut b, 1)?;
-        let err = b.iter().map(|x| (x - 1.0).abs()).fold(0.0, |m: f64, e| if e.is_nan() { f64::INFINITY } else { m.max(e) });
+        let err = b.iter().map(|x| (x - 1.0).abs()).fold(0.0, |m: f64, e| {
+            if e.is_nan() {
+                f64::INFINITY
+            } else {
+                m.max(e)
+            }
+        });
         if !(err <= self.singularity_tolerance) {
             self.numeric = None;
             return Err(SolverError::Singular {
                 column: None,
-                detail: format!("numerically zero pivot: the check solve A x = A·1 is off by {err:.3e}"),
+                detail: format!(
+                    "numerically zero pivot: the check solve A x = A·1 is off by {err:.3e}"
+                ),
             });
         }
         Ok(())

@@ -23,13 +23,19 @@ pub(crate) fn column_counts(symbolic: &SymbolicCholesky<usize>) -> Vec<usize> {
 /// nnz(L) and the flop count Σ c_j² of a left-looking Cholesky with column counts c_j.
 pub(crate) fn fill_and_flops(symbolic: &SymbolicCholesky<usize>) -> (usize, f64) {
     let c = column_counts(symbolic);
-    (c.iter().sum(), c.iter().map(|&x| (x as f64) * (x as f64)).sum())
+    (
+        c.iter().sum(),
+        c.iter().map(|&x| (x as f64) * (x as f64)).sum(),
+    )
 }
 
 /// The diagonal entries of the factor values (L_jj for LLᵀ, D_j for LDLᵀ), in factor order.
 pub(crate) fn factor_diagonal(symbolic: &SymbolicCholesky<usize>, values: &[f64]) -> Vec<f64> {
     match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..s.ncols()].iter().map(|&p| values[p]).collect(),
+        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..s.ncols()]
+            .iter()
+            .map(|&p| values[p])
+            .collect(),
         SymbolicCholeskyRaw::Supernodal(s) => {
             let mut d = Vec::with_capacity(s.ncols());
             for k in 0..s.n_supernodes() {
