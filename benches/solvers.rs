@@ -12,6 +12,7 @@ use std::path::Path;
 type Make = Box<dyn Fn() -> Box<dyn LinearSolver>>;
 
 fn backends() -> Vec<(&'static str, Make)> {
+    #[allow(unused_mut)] // extended with the cholmod feature
     let mut v: Vec<(&'static str, Make)> = vec![
         (
             "faer-llt-amd",

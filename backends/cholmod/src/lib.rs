@@ -9,7 +9,7 @@ mod common;
 
 use common::Common;
 use fibercell_solver::{
-    compute_ordering, AnalyzeInfo, Capabilities, CscRef, LinearSolver, Ordering,
+    compute_ordering, AnalyzeInfo, Capabilities, CscRef, LinearSolver, LowerTriangle, Ordering,
     PatternFingerprint, SolveInfo, SolverError,
 };
 use std::os::raw::{c_int, c_long, c_void};
@@ -26,9 +26,9 @@ pub struct Cholmod {
 struct State {
     n: usize,
     fingerprint: PatternFingerprint,
+    lower: LowerTriangle,
     col_ptr: Vec<c_long>,
     row_idx: Vec<c_long>,
-    lower_src: Vec<usize>,
     values: Vec<f64>,
     scale: Vec<f64>,
     factor: *mut ss::cholmod_factor,
@@ -137,20 +137,14 @@ impl LinearSolver for Cholmod {
         }
         let n = a.ncols();
         let too_big = || SolverError::InvalidMatrix("index does not fit CHOLMOD's long".into());
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
-        let mut lower_src = Vec::new();
-        col_ptr.push(0);
-        for j in 0..n {
-            let start = a.col_ptr()[j];
-            for (k, &i) in a.col(j).0.iter().enumerate() {
-                if i >= j {
-                    row_idx.push(c_long::try_from(i).map_err(|_| too_big())?);
-                    lower_src.push(start + k);
-                }
-            }
-            col_ptr.push(c_long::try_from(row_idx.len()).map_err(|_| too_big())?);
-        }
+        let lower = LowerTriangle::of(a);
+        let to_long = |v: &[usize]| -> Result<Vec<c_long>, SolverError> {
+            v.iter()
+                .map(|&x| c_long::try_from(x).map_err(|_| too_big()))
+                .collect()
+        };
+        let col_ptr = to_long(&lower.col_ptr)?;
+        let row_idx = to_long(&lower.row_idx)?;
         let mut perm: Option<Vec<c_long>> = None;
         let (nmethods, method, name) = match &self.ordering {
             Ordering::Auto => (0, ss::CHOLMOD_AMD, "cholmod-default"),
@@ -162,13 +156,13 @@ impl LinearSolver for Cholmod {
                 (1, ss::CHOLMOD_GIVEN, o.name())
             }
         };
-        let nnz = lower_src.len();
+        let nnz = lower.nnz();
         let mut state = State {
             n,
             fingerprint: a.fingerprint(),
+            lower,
             col_ptr,
             row_idx,
-            lower_src,
             values: vec![0.0; nnz],
             scale: vec![1.0; n],
             factor: std::ptr::null_mut(),
@@ -217,27 +211,7 @@ impl LinearSolver for Cholmod {
             return Err(SolverError::PatternChanged);
         }
         s.factorized = false;
-        for j in 0..s.n {
-            let first = s.col_ptr[j] as usize;
-            let ajj = if s.row_idx.get(first) == Some(&(j as c_long)) {
-                a.values()[s.lower_src[first]]
-            } else {
-                0.0
-            };
-            if !(ajj > 0.0) {
-                return Err(SolverError::NotPositiveDefinite {
-                    column: j,
-                    pivot: ajj,
-                });
-            }
-            s.scale[j] = 1.0 / ajj.sqrt();
-        }
-        for j in 0..s.n {
-            for k in s.col_ptr[j] as usize..s.col_ptr[j + 1] as usize {
-                let i = s.row_idx[k] as usize;
-                s.values[k] = a.values()[s.lower_src[k]] * s.scale[i] * s.scale[j];
-            }
-        }
+        s.lower.scaled_values(a, &mut s.scale, &mut s.values)?;
         let c = common.as_mut_ptr();
         let mut header = s.header();
         // SAFETY: factor and common are live and belong together; header points to live arrays.

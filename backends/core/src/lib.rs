@@ -18,12 +18,14 @@
 
 mod csc;
 mod error;
+mod lower;
 mod ordering;
 mod residual;
 mod solver;
 
 pub use csc::{CscMatrix, CscRef, PatternFingerprint};
 pub use error::{SolverError, StopReason};
+pub use lower::LowerTriangle;
 pub use ordering::{compute_ordering, Ordering, Permutation};
 pub use residual::{backward_error, relative_residual, solve_checked, SolveReport};
 pub use solver::{AnalyzeInfo, Capabilities, LinearSolver, SolveInfo};

@@ -17,7 +17,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use fibercell_solver::{
-    compute_ordering, AnalyzeInfo, Capabilities, CscRef, LinearSolver, Ordering,
+    compute_ordering, AnalyzeInfo, Capabilities, CscRef, LinearSolver, LowerTriangle, Ordering,
     PatternFingerprint, Permutation, SolveInfo, SolverError,
 };
 
@@ -45,10 +45,7 @@ pub struct FaerCholesky {
 struct Analysis {
     n: usize,
     fingerprint: PatternFingerprint,
-    lower_col_ptr: Vec<usize>,
-    lower_row_idx: Vec<usize>,
-    /// For every entry of the lower triangle, its index in the full matrix's values.
-    lower_src: Vec<usize>,
+    lower: LowerTriangle,
     /// The permutation faer factorizes with (`fwd[new] = old`).
     perm: Permutation,
     symbolic: SymbolicCholesky<usize>,
@@ -136,22 +133,14 @@ impl LinearSolver for FaerCholesky {
         self.factor = None;
         self.analysis = None;
         let n = a.ncols();
-        let mut lower_col_ptr = Vec::with_capacity(n + 1);
-        let mut lower_row_idx = Vec::new();
-        let mut lower_src = Vec::new();
-        lower_col_ptr.push(0);
-        for j in 0..n {
-            let start = a.col_ptr()[j];
-            for (k, &i) in a.col(j).0.iter().enumerate() {
-                if i >= j {
-                    lower_row_idx.push(i);
-                    lower_src.push(start + k);
-                }
-            }
-            lower_col_ptr.push(lower_row_idx.len());
-        }
-        let lower =
-            SymbolicSparseColMatRef::new_checked(n, n, &lower_col_ptr, None, &lower_row_idx);
+        let lower_tri = LowerTriangle::of(a);
+        let lower = SymbolicSparseColMatRef::new_checked(
+            n,
+            n,
+            &lower_tri.col_ptr,
+            None,
+            &lower_tri.row_idx,
+        );
         let (perm, symbolic, name) = match &self.ordering {
             Ordering::Auto => {
                 // Both candidates, keep the one with fewer predicted flops.
@@ -187,9 +176,7 @@ impl LinearSolver for FaerCholesky {
         self.analysis = Some(Analysis {
             n,
             fingerprint: a.fingerprint(),
-            lower_col_ptr,
-            lower_row_idx,
-            lower_src,
+            lower: lower_tri,
             perm,
             symbolic,
         });
@@ -210,31 +197,12 @@ impl LinearSolver for FaerCholesky {
         let mut f = self.factor.take().unwrap_or_else(|| Factor {
             l_values: vec![0.0; an.symbolic.len_val()],
             scale: vec![0.0; n],
-            lower_values: vec![0.0; an.lower_src.len()],
+            lower_values: vec![0.0; an.lower.nnz()],
         });
-        for j in 0..n {
-            let d = an.lower_src[an.lower_col_ptr[j]];
-            let ajj = a.values()[d];
-            if an.lower_row_idx[an.lower_col_ptr[j]] != j || !(ajj > 0.0) {
-                return Err(pivot_error(
-                    j,
-                    if an.lower_row_idx[an.lower_col_ptr[j]] == j {
-                        ajj
-                    } else {
-                        0.0
-                    },
-                ));
-            }
-            f.scale[j] = 1.0 / ajj.sqrt();
-        }
-        for j in 0..n {
-            for k in an.lower_col_ptr[j]..an.lower_col_ptr[j + 1] {
-                let i = an.lower_row_idx[k];
-                f.lower_values[k] = a.values()[an.lower_src[k]] * f.scale[i] * f.scale[j];
-            }
-        }
+        an.lower
+            .scaled_values(a, &mut f.scale, &mut f.lower_values)?;
         let lower = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &an.lower_col_ptr, None, &an.lower_row_idx),
+            SymbolicSparseColMatRef::new_checked(n, n, &an.lower.col_ptr, None, &an.lower.row_idx),
             &f.lower_values,
         );
         let sym = &an.symbolic;

@@ -1,22 +1,27 @@
 //! Reading the pivots back out of a faer Cholesky factor, to catch (near-)zero pivots that
 //! faer accepts, and to count fill and flops.
 
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
+
+type SupernodalSymbolic = SymbolicSupernodalCholesky<usize>;
+
+/// Each supernode as (first column, end column, rows of its dense block, first value index).
+fn supernodes(s: &SupernodalSymbolic) -> impl Iterator<Item = (usize, usize, usize, usize)> + '_ {
+    (0..s.n_supernodes()).map(move |k| {
+        let (b, e) = (s.supernode_begin()[k], s.supernode_end()[k]);
+        let below = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];
+        (b, e, (e - b) + below, s.col_ptr_for_val()[k])
+    })
+}
 
 /// Entries per column of L (diagonal included), in factor (permuted) order.
 pub(crate) fn column_counts(symbolic: &SymbolicCholesky<usize>) -> Vec<usize> {
     match symbolic.raw() {
         SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr().windows(2).map(|w| w[1] - w[0]).collect(),
-        SymbolicCholeskyRaw::Supernodal(s) => {
-            let mut counts = Vec::with_capacity(s.ncols());
-            for k in 0..s.n_supernodes() {
-                let (b, e) = (s.supernode_begin()[k], s.supernode_end()[k]);
-                let below = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];
-                let rows = (e - b) + below;
-                counts.extend((0..e - b).map(|c| rows - c));
-            }
-            counts
-        }
+        SymbolicCholeskyRaw::Supernodal(s) => supernodes(s)
+            .flat_map(|(b, e, rows, _)| (0..e - b).map(move |c| rows - c))
+            .collect(),
     }
 }
 
@@ -36,17 +41,9 @@ pub(crate) fn factor_diagonal(symbolic: &SymbolicCholesky<usize>, values: &[f64]
             .iter()
             .map(|&p| values[p])
             .collect(),
-        SymbolicCholeskyRaw::Supernodal(s) => {
-            let mut d = Vec::with_capacity(s.ncols());
-            for k in 0..s.n_supernodes() {
-                let (b, e) = (s.supernode_begin()[k], s.supernode_end()[k]);
-                let below = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];
-                let rows = (e - b) + below;
-                let start = s.col_ptr_for_val()[k];
-                d.extend((0..e - b).map(|c| values[start + c * rows + c]));
-            }
-            d
-        }
+        SymbolicCholeskyRaw::Supernodal(s) => supernodes(s)
+            .flat_map(|(b, e, rows, start)| (0..e - b).map(move |c| values[start + c * rows + c]))
+            .collect(),
     }
 }
 
