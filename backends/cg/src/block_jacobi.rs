@@ -1,7 +1,6 @@
 //! Block-Jacobi preconditioner: the inverses of the diagonal blocks, applied block by block.
 
 use fibercell_solver::{CscRef, SolverError};
-use rayon::prelude::*;
 
 /// Inverted diagonal blocks of a symmetric positive definite matrix, each stored as a dense
 /// Cholesky factor.
@@ -63,43 +62,48 @@ impl BlockJacobi {
         })
     }
 
-    /// z = M⁻¹ r.
+    /// z = M⁻¹ r, blocks in parallel (recursive halving at block boundaries, no allocation).
     pub fn apply(&self, r: &[f64], z: &mut [f64]) {
-        let n = r.len();
-        let bounds: Vec<(usize, usize)> = (0..self.starts.len())
-            .map(|k| (self.starts[k], self.starts.get(k + 1).copied().unwrap_or(n)))
-            .collect();
-        // Split z into the blocks so each task owns its slice.
-        let mut parts: Vec<&mut [f64]> = Vec::with_capacity(bounds.len());
-        let mut rest = z;
-        for &(s, e) in &bounds {
-            let (head, tail) = rest.split_at_mut(e - s);
-            parts.push(head);
-            rest = tail;
+        self.apply_range(0, self.starts.len(), r, z);
+    }
+
+    fn block_end(&self, k: usize, n: usize) -> usize {
+        self.starts.get(k + 1).copied().unwrap_or(n)
+    }
+
+    /// Applies blocks lo..hi; `z` covers exactly their rows.
+    fn apply_range(&self, lo: usize, hi: usize, r: &[f64], z: &mut [f64]) {
+        if hi - lo > 256 {
+            let mid = (lo + hi) / 2;
+            let (za, zb) = z.split_at_mut(self.starts[mid] - self.starts[lo]);
+            rayon::join(
+                || self.apply_range(lo, mid, r, za),
+                || self.apply_range(mid, hi, r, zb),
+            );
+            return;
         }
-        parts
-            .into_par_iter()
-            .with_min_len(256)
-            .enumerate()
-            .for_each(|(k, zk)| {
-                let (s, e) = bounds[k];
-                let b = e - s;
-                let l = &self.factors[self.offsets[k]..self.offsets[k + 1]];
-                // Forward then backward substitution with L and Lᵀ.
-                for i in 0..b {
-                    let mut v = r[s + i];
-                    for q in 0..i {
-                        v -= l[i * b + q] * zk[q];
-                    }
-                    zk[i] = v / l[i * b + i];
+        let base = self.starts.get(lo).copied().unwrap_or(0);
+        let n = r.len();
+        for k in lo..hi {
+            let (s, e) = (self.starts[k], self.block_end(k, n));
+            let b = e - s;
+            let l = &self.factors[self.offsets[k]..self.offsets[k + 1]];
+            let zk = &mut z[s - base..e - base];
+            // Forward then backward substitution with L and Lᵀ.
+            for i in 0..b {
+                let mut v = r[s + i];
+                for q in 0..i {
+                    v -= l[i * b + q] * zk[q];
                 }
-                for i in (0..b).rev() {
-                    let mut v = zk[i];
-                    for q in i + 1..b {
-                        v -= l[q * b + i] * zk[q];
-                    }
-                    zk[i] = v / l[i * b + i];
+                zk[i] = v / l[i * b + i];
+            }
+            for i in (0..b).rev() {
+                let mut v = zk[i];
+                for q in i + 1..b {
+                    v -= l[q * b + i] * zk[q];
                 }
-            });
+                zk[i] = v / l[i * b + i];
+            }
+        }
     }
 }

@@ -53,6 +53,8 @@ struct Analysis {
 
 struct Factor {
     l_values: Vec<f64>,
+    /// Workspace of the numeric factorization, sized once per analysis.
+    scratch: MemBuffer,
     scale: Vec<f64>,
     lower_values: Vec<f64>,
 }
@@ -194,11 +196,25 @@ impl LinearSolver for FaerCholesky {
         }
         let n = an.n;
         // Reuse the buffers of the previous factorization when there is one.
-        let mut f = self.factor.take().unwrap_or_else(|| Factor {
-            l_values: vec![0.0; an.symbolic.len_val()],
-            scale: vec![0.0; n],
-            lower_values: vec![0.0; an.lower.nnz()],
-        });
+        let mut f = match self.factor.take() {
+            Some(f) => f,
+            None => {
+                let req = match self.variant {
+                    CholeskyVariant::Llt => an
+                        .symbolic
+                        .factorize_numeric_llt_scratch::<f64>(self.par, Spec::default()),
+                    CholeskyVariant::Ldlt => an
+                        .symbolic
+                        .factorize_numeric_ldlt_scratch::<f64>(self.par, Spec::default()),
+                };
+                Factor {
+                    l_values: vec![0.0; an.symbolic.len_val()],
+                    scratch: MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?,
+                    scale: vec![0.0; n],
+                    lower_values: vec![0.0; an.lower.nnz()],
+                }
+            }
+        };
         an.lower
             .scaled_values(a, &mut f.scale, &mut f.lower_values)?;
         let lower = SparseColMatRef::new(
@@ -216,15 +232,13 @@ impl LinearSolver for FaerCholesky {
         };
         match self.variant {
             CholeskyVariant::Llt => {
-                let req = sym.factorize_numeric_llt_scratch::<f64>(self.par, Spec::default());
-                let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
                 let r = sym.factorize_numeric_llt(
                     &mut f.l_values,
                     lower,
                     Side::Lower,
                     LltRegularization::default(),
                     self.par,
-                    MemStack::new(&mut buf),
+                    MemStack::new(&mut f.scratch),
                     Spec::default(),
                 );
                 if let Err(LltError::NonPositivePivot { index }) = r {
@@ -232,15 +246,13 @@ impl LinearSolver for FaerCholesky {
                 }
             }
             CholeskyVariant::Ldlt => {
-                let req = sym.factorize_numeric_ldlt_scratch::<f64>(self.par, Spec::default());
-                let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
                 let r = sym.factorize_numeric_ldlt(
                     &mut f.l_values,
                     lower,
                     Side::Lower,
                     LdltRegularization::default(),
                     self.par,
-                    MemStack::new(&mut buf),
+                    MemStack::new(&mut f.scratch),
                     Spec::default(),
                 );
                 if let Err(e) = r {
