@@ -47,7 +47,7 @@ struct SharedValues(*mut f64);
 unsafe impl Sync for SharedValues {}
 unsafe impl Send for SharedValues {}
 
-fn scatter(k: &Matrix12, slots: &[u32; 144], mut add: impl FnMut(usize, f64)) {
+fn scatter(k: &Matrix12, slots: &[u32], mut add: impl FnMut(usize, f64)) {
     for r in 0..12 {
         for c in 0..12 {
             let s = slots[r * 12 + c];

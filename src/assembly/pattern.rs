@@ -1,38 +1,58 @@
 //! The sparsity pattern of the reduced stiffness (both triangles) and the slot map that sends
-//! every entry of every element matrix to its place in the value array — built once, so value
-//! fills never search or sort.
+//! every entry of every block matrix — the 12×12 frame elements, then any extra node blocks such
+//! as the 24×24 contact blocks coupling four nodes (thesis 4.69–4.70) — to its place in the value
+//! array. Built once per set of blocks, so value fills never search or sort.
 
 use super::DofMap;
 use crate::model::Model;
 use fibercell_solver::{CscRef, SolverError};
 
-/// Slot of an element-matrix entry that touches a prescribed DOF.
+/// Slot of a block-matrix entry that touches a prescribed DOF.
 pub const NO_SLOT: u32 = u32::MAX;
 
-/// CSC pattern of the reduced system plus, per element, the value slot of each of its 144
-/// entries (row-major, `NO_SLOT` for prescribed rows or columns).
+/// CSC pattern of the reduced system plus, per block, the value slot of each entry of its dense
+/// (6k × 6k, row-major) matrix, k = number of nodes of the block.
 #[derive(Clone, Debug)]
 pub struct Pattern {
     n: usize,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
-    element_slots: Vec<[u32; 144]>,
+    n_elements: usize,
+    block_offsets: Vec<usize>,
+    slots: Vec<u32>,
 }
 
-/// Errors of pattern construction.
+/// The pattern has more entries than the 32-bit slot map can address.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("the stiffness pattern has {0} entries, more than the 32-bit slot map holds")]
 pub struct PatternTooLargeError(pub usize);
 
 impl Pattern {
-    /// Builds the pattern of the frame elements of `model` under `dofs`.
+    /// The pattern of the frame elements of `model`.
     pub fn new(model: &Model, dofs: &DofMap) -> Result<Self, PatternTooLargeError> {
+        Self::with_blocks(model, dofs, &[])
+    }
+
+    /// The pattern of the frame elements (blocks 0..n_elements) and of `extra` node blocks
+    /// (blocks n_elements.., e.g. contact pairs), each a list of distinct node indices.
+    pub fn with_blocks(
+        model: &Model,
+        dofs: &DofMap,
+        extra: &[Vec<usize>],
+    ) -> Result<Self, PatternTooLargeError> {
         let n_nodes = model.nodes.len();
+        let elements: Vec<[usize; 2]> = model.elements().iter().map(|e| e.nodes).collect();
+        let blocks = || {
+            elements
+                .iter()
+                .map(|e| &e[..])
+                .chain(extra.iter().map(|b| &b[..]))
+        };
         let mut adjacency: Vec<Vec<usize>> = (0..n_nodes).map(|i| vec![i]).collect();
-        for e in model.elements() {
-            let [a, b] = e.nodes;
-            adjacency[a].push(b);
-            adjacency[b].push(a);
+        for b in blocks() {
+            for &p in b {
+                adjacency[p].extend_from_slice(b);
+            }
         }
         for adj in &mut adjacency {
             adj.sort_unstable();
@@ -57,31 +77,37 @@ impl Pattern {
         if row_idx.len() >= NO_SLOT as usize {
             return Err(PatternTooLargeError(row_idx.len()));
         }
-        let mut element_slots = Vec::with_capacity(model.elements().len());
-        for e in model.elements() {
-            let globals: Vec<usize> = e
-                .nodes
+        let mut block_offsets = vec![0];
+        let mut slots = Vec::with_capacity(
+            144 * elements.len() + extra.iter().map(|b| 36 * b.len() * b.len()).sum::<usize>(),
+        );
+        for b in blocks() {
+            let m = 6 * b.len();
+            let globals: Vec<usize> = b
                 .iter()
                 .flat_map(|&nd| (0..6).map(move |d| 6 * nd + d))
                 .collect();
-            let mut slots = [NO_SLOT; 144];
+            let start = slots.len();
+            slots.resize(start + m * m, NO_SLOT);
             for (c, &gc) in globals.iter().enumerate() {
                 let Some(jc) = dofs.reduced(gc) else { continue };
                 let rows = &row_idx[col_ptr[jc]..col_ptr[jc + 1]];
                 for (r, &gr) in globals.iter().enumerate() {
                     let Some(ir) = dofs.reduced(gr) else { continue };
                     if let Ok(k) = rows.binary_search(&ir) {
-                        slots[r * 12 + c] = (col_ptr[jc] + k) as u32;
+                        slots[start + r * m + c] = (col_ptr[jc] + k) as u32;
                     }
                 }
             }
-            element_slots.push(slots);
+            block_offsets.push(slots.len());
         }
         Ok(Pattern {
             n,
             col_ptr,
             row_idx,
-            element_slots,
+            n_elements: elements.len(),
+            block_offsets,
+            slots,
         })
     }
 
@@ -101,9 +127,20 @@ impl Pattern {
     pub fn row_idx(&self) -> &[usize] {
         &self.row_idx
     }
+    /// Number of blocks (elements first, then the extra blocks).
+    pub fn n_blocks(&self) -> usize {
+        self.block_offsets.len() - 1
+    }
     /// Slot map of element `e` (row-major 12×12).
-    pub fn element_slots(&self, e: usize) -> &[u32; 144] {
-        &self.element_slots[e]
+    pub fn element_slots(&self, e: usize) -> &[u32] {
+        self.block_slots(e)
+    }
+    /// Slot map of extra block `b` (row-major 6k × 6k).
+    pub fn extra_slots(&self, b: usize) -> &[u32] {
+        self.block_slots(self.n_elements + b)
+    }
+    fn block_slots(&self, b: usize) -> &[u32] {
+        &self.slots[self.block_offsets[b]..self.block_offsets[b + 1]]
     }
     /// A matrix view with these values.
     pub fn matrix<'a>(&'a self, values: &'a [f64]) -> Result<CscRef<'a>, SolverError> {
