@@ -21,6 +21,7 @@
 
 pub mod assembly;
 pub mod constraints;
+pub mod contact;
 pub mod element;
 mod error;
 pub mod generate;

@@ -1,0 +1,161 @@
+//! Penalty contact contributions of one contact pair (thesis 4.53–4.65), in terms of the jump
+//! operator B ([u] = B q), the unit normal n and an orthonormal basis E = [e₁ e₂] of the tangent
+//! plane:
+//!
+//! * normal (4.53, 4.54): K_N = p_N Bᵀ n nᵀ B, F_N = p_N ḡ Bᵀ n — the contact is active when the
+//!   penetration nᵀ B q − ḡ is positive, with normal force N = p_N (nᵀ B q − ḡ);
+//! * stick (4.58): K_T = p_T Bᵀ E Eᵀ B, F_T = p_T Bᵀ E s, with s the accumulated slip; the
+//!   tangential force is F_t = p_T (Eᵀ B q − s);
+//! * Coulomb slip (4.63, 4.64): F_t = μ N d along the slip direction d, so
+//!   K_T = μ p_N Bᵀ E d nᵀ B (rank one, **nonsymmetric**), F_T = μ p_N ḡ Bᵀ E d;
+//! * Tresca slip (4.65): F_t = G d, a constant load F_T = −G Bᵀ E d.
+//!
+//! E is built from the tangent of fiber I projected on the tangent plane; for fibers crossing
+//! at right angles its two vectors are the two fiber tangents of the thesis.
+
+use super::kinematics::Jump;
+use nalgebra::{SMatrix, SVector, Vector2, Vector3};
+
+/// A 24 × 24 contact block (the top-left 6k × 6k part is used).
+pub type BlockMatrix = SMatrix<f64, 24, 24>;
+/// A 24-vector of block loads.
+pub type BlockVector = SVector<f64, 24>;
+
+/// The friction law.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum Friction {
+    /// Frictionless: no tangential terms.
+    #[default]
+    None,
+    /// Coulomb: |F_t| ≤ μ N.
+    Coulomb {
+        /// Friction coefficient μ ≥ 0.
+        mu: f64,
+    },
+    /// Tresca: |F_t| ≤ G, independent of N.
+    Tresca {
+        /// Friction bound G ≥ 0 (N).
+        bound: f64,
+    },
+}
+
+/// State of a contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ContactState {
+    /// Not in contact (no forces).
+    Open,
+    /// In contact, tangentially stuck.
+    Stick,
+    /// In contact, sliding at the friction bound.
+    Slip,
+}
+
+impl ContactState {
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactState::Open => "open",
+            ContactState::Stick => "stick",
+            ContactState::Slip => "slip",
+        }
+    }
+}
+
+/// Geometry and penalties of one contact pair.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPair {
+    /// Jump operator over the block's nodes.
+    pub jump: Jump,
+    /// Unit normal from side I to side II.
+    pub normal: Vector3<f64>,
+    /// Orthonormal tangent-plane basis.
+    pub tangents: [Vector3<f64>; 2],
+    /// Initial gap ḡ (m) used in the penalty law (after any strain-free adjustment).
+    pub gap: f64,
+    /// Normal penalty p_N (N/m).
+    pub penalty_normal: f64,
+    /// Tangential penalty p_T (N/m).
+    pub penalty_tangent: f64,
+}
+
+/// Tangent-plane basis from a preferred direction (projected) and the normal.
+pub fn tangent_basis(normal: &Vector3<f64>, preferred: &Vector3<f64>) -> [Vector3<f64>; 2] {
+    let mut t = preferred - normal * normal.dot(preferred);
+    if t.norm() < 1e-8 * preferred.norm().max(1e-300) {
+        let k = (0..3)
+            .min_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
+            .unwrap_or(0);
+        let mut aux = Vector3::zeros();
+        aux[k] = 1.0;
+        t = aux - normal * normal[k];
+    }
+    let e1 = t.normalize();
+    [e1, normal.cross(&e1)]
+}
+
+/// Per-pair quantities that depend on the displacement of its nodes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairKinematics {
+    /// Penetration nᵀ B q − ḡ (positive: in contact).
+    pub penetration: f64,
+    /// Tangential relative displacement Eᵀ B q.
+    pub tangential: Vector2<f64>,
+}
+
+impl ContactPair {
+    /// Number of rows/columns of the block actually used.
+    pub fn size(&self) -> usize {
+        6 * self.jump.nodes.len()
+    }
+
+    fn bt_n(&self) -> BlockVector {
+        self.jump.b.transpose() * self.normal
+    }
+
+    fn bt_e(&self, d: &Vector2<f64>) -> BlockVector {
+        self.jump.b.transpose() * (self.tangents[0] * d[0] + self.tangents[1] * d[1])
+    }
+
+    /// Penetration and tangential relative displacement for the block DOFs `q`.
+    pub fn kinematics(&self, q: &BlockVector) -> PairKinematics {
+        let jump = self.jump.b * q;
+        PairKinematics {
+            penetration: self.normal.dot(&jump) - self.gap,
+            tangential: Vector2::new(self.tangents[0].dot(&jump), self.tangents[1].dot(&jump)),
+        }
+    }
+
+    /// K_N and F_N of an active contact (4.53, 4.54).
+    pub fn normal(&self) -> (BlockMatrix, BlockVector) {
+        let bn = self.bt_n();
+        (
+            bn * bn.transpose() * self.penalty_normal,
+            bn * (self.penalty_normal * self.gap),
+        )
+    }
+
+    /// K_T^st and F_T of a stuck contact with accumulated slip `slip` (4.58).
+    pub fn stick(&self, slip: &Vector2<f64>) -> (BlockMatrix, BlockVector) {
+        let b1 = self.bt_e(&Vector2::new(1.0, 0.0));
+        let b2 = self.bt_e(&Vector2::new(0.0, 1.0));
+        let k = (b1 * b1.transpose() + b2 * b2.transpose()) * self.penalty_tangent;
+        let f = (b1 * slip[0] + b2 * slip[1]) * self.penalty_tangent;
+        (k, f)
+    }
+
+    /// K_T^sl and F_T^sl of a contact sliding along the unit direction `d` (tangent basis).
+    pub fn slip(&self, friction: Friction, d: &Vector2<f64>) -> (BlockMatrix, BlockVector) {
+        let bd = self.bt_e(d);
+        match friction {
+            Friction::None => (BlockMatrix::zeros(), BlockVector::zeros()),
+            Friction::Coulomb { mu } => {
+                let bn = self.bt_n();
+                (
+                    bd * bn.transpose() * (mu * self.penalty_normal),
+                    bd * (mu * self.penalty_normal * self.gap),
+                )
+            }
+            Friction::Tresca { bound } => (BlockMatrix::zeros(), bd * (-bound)),
+        }
+    }
+}

@@ -1,0 +1,15 @@
+//! Beam-to-beam frictional contact with the penalty method (thesis §4.3): search, kinematics of
+//! the contact points, normal and tangential contributions, and the contact set with its
+//! stick/slip states.
+
+mod geometry;
+mod kinematics;
+mod law;
+mod search;
+
+pub use geometry::{closest_points, ClosestPoints};
+pub use kinematics::{centerline_interpolation, jump_operator, ContactSide, Jump, JumpMatrix};
+pub use law::{
+    tangent_basis, BlockMatrix, BlockVector, ContactPair, ContactState, Friction, PairKinematics,
+};
+pub use search::{find_candidates, find_candidates_brute_force, Candidate};
