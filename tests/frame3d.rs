@@ -66,6 +66,7 @@ fn l_frame_out_of_plane_load_matches_castigliano() {
             force: [0.0, p, 0.0],
             moment: [0.0; 3],
         }],
+        ..Default::default()
     };
     let sol = solve(&build(&d));
     let ei = E * PI * r.powi(4) / 4.0;

@@ -65,5 +65,6 @@ pub fn clamped_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDes
             force: [10.0, -20.0, 5.0],
             moment: [0.1, 0.2, -0.3],
         }],
+        ..Default::default()
     }
 }

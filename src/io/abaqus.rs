@@ -592,6 +592,7 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
         fibers,
         supports: r.supports,
         loads: r.loads,
+        ..Default::default()
     })
 }
 

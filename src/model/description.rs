@@ -26,6 +26,12 @@ pub struct ModelDescription {
     /// Nodal forces and moments.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub loads: Vec<LoadSpec>,
+    /// Contact settings; a model without them has no contact.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSpec>,
+    /// Explicit contact pairs.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactPairSpec>,
 }
 
 /// `[[materials]]`: E with exactly one of ν and G.
@@ -94,4 +100,108 @@ pub struct LoadSpec {
     /// Moment (N·m).
     #[serde(default)]
     pub moment: [f64; 3],
+}
+
+/// `[contact]`: how fibers touch. Without it a model has no contact.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Search for contacts between all fibers (default true); explicit `[[contacts]]` are
+    /// always used.
+    #[serde(default = "yes")]
+    pub search: bool,
+    /// Surfaces closer than this count as candidate pairs (m; default: the largest radius).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Normal penalty p_N (N/m); default 1000 × the largest transverse element stiffness
+    /// 12EI/L³ of the two elements in contact.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty_normal: Option<f64>,
+    /// Tangential penalty p_T (N/m); default equal to the normal penalty.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty_tangent: Option<f64>,
+    /// Friction law.
+    #[serde(default)]
+    pub friction: FrictionSpec,
+    /// Initially penetrating pairs: "adjust" (strain-free: their gap is set to 0, default) or
+    /// "resolve" (pushed apart over the increments).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_penetration: Option<PenetrationSpec>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// `friction = { law = "coulomb", mu = 0.3 }`, `{ law = "tresca", bound = 0.5 }` or
+/// `{ law = "none" }`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "law", rename_all = "lowercase", deny_unknown_fields)]
+pub enum FrictionSpec {
+    /// Frictionless.
+    #[default]
+    None,
+    /// Coulomb friction coefficient μ ≥ 0.
+    Coulomb {
+        /// μ.
+        mu: f64,
+    },
+    /// Tresca friction bound G ≥ 0 (N).
+    Tresca {
+        /// G.
+        bound: f64,
+    },
+}
+
+/// How initially penetrating pairs are treated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PenetrationSpec {
+    /// Set their gap to zero: touching, stress free.
+    Adjust,
+    /// Keep the negative gap: the penalty pushes them apart as the load is applied.
+    Resolve,
+}
+
+/// `[[contacts]]`: an explicit contact pair between two nodes or points on fibers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactPairSpec {
+    /// Side I.
+    pub a: SideSpec,
+    /// Side II.
+    pub b: SideSpec,
+    /// Unit normal from I to II (default: from the position of I to that of II).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// Initial gap ḡ (m; default 0: touching).
+    #[serde(default)]
+    pub gap: f64,
+    /// Normal penalty for this pair (N/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty_normal: Option<f64>,
+    /// Tangential penalty for this pair (N/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty_tangent: Option<f64>,
+}
+
+/// A contact side: `{ node = 3 }` or `{ fiber = 2, segment = 0, xi = 0.5 }` (the point at
+/// parameter ξ ∈ [0, 1] of the fiber's segment, counted from 0).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged, deny_unknown_fields)]
+pub enum SideSpec {
+    /// A node.
+    Node {
+        /// Node id.
+        node: u64,
+    },
+    /// A point on a fiber segment.
+    Point {
+        /// Fiber id.
+        fiber: u64,
+        /// Segment index along the fiber (0-based).
+        segment: usize,
+        /// Parameter along the segment.
+        xi: f64,
+    },
 }

@@ -108,4 +108,12 @@ pub enum ModelError {
         /// The DOF.
         dof: Dof,
     },
+    /// Invalid contact settings or explicit contact pair.
+    #[error("{item}: {message}")]
+    InvalidContact {
+        /// "[contact]" or "contact pair 3".
+        item: String,
+        /// What is wrong.
+        message: String,
+    },
 }

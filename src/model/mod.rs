@@ -1,6 +1,7 @@
 //! The fiber network: nodes, fibers (polylines of 2-node frame elements), circular sections,
 //! materials, supports and nodal loads — validated on construction.
 
+mod contact_settings;
 mod description;
 mod dof;
 mod error;
@@ -8,7 +9,11 @@ mod material;
 mod network;
 mod section;
 
-pub use description::{FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec};
+pub use contact_settings::{ContactSettings, ExplicitContact};
+pub use description::{
+    ContactPairSpec, ContactSpec, FiberSpec, FrictionSpec, LoadSpec, MaterialSpec,
+    ModelDescription, NodeSpec, PenetrationSpec, SideSpec, SupportSpec,
+};
 pub use dof::{Dof, DofSet};
 pub use error::ModelError;
 pub use material::Material;

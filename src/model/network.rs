@@ -1,6 +1,10 @@
 //! The validated [`Model`].
 
-use super::{Dof, Material, ModelDescription, ModelError, Section};
+use super::contact_settings::{check_pair, check_settings, ContactSettings, ExplicitContact};
+use super::{
+    ContactPairSpec, ContactSpec, Dof, Material, ModelDescription, ModelError, Section, SideSpec,
+};
+use crate::contact::ContactSide;
 use std::collections::HashMap;
 
 /// A node.
@@ -71,8 +75,13 @@ pub struct Model {
     pub supports: Vec<Support>,
     /// Nodal loads (components; several on one DOF add up).
     pub loads: Vec<Load>,
+    /// Contact settings, when the model has `[contact]`.
+    pub contact: Option<ContactSettings>,
+    /// Explicit contact pairs.
+    pub explicit_contacts: Vec<ExplicitContact>,
     elements: Vec<Element>,
     node_index: HashMap<u64, usize>,
+    contact_specs: (Option<ContactSpec>, Vec<ContactPairSpec>),
 }
 
 fn check_material(m: &super::MaterialSpec) -> Result<Material, ModelError> {
@@ -277,6 +286,61 @@ impl Model {
                 }
             }
         }
+        let max_radius = fibers.iter().map(|f| f.section.radius).fold(0.0, f64::max);
+        let contact = d
+            .contact
+            .as_ref()
+            .map(|c| check_settings(c, max_radius))
+            .transpose()?;
+        let first_element: Vec<usize> = {
+            let mut v = Vec::with_capacity(fibers.len());
+            let mut count = 0;
+            for f in &fibers {
+                v.push(count);
+                count += f.nodes.len() - 1;
+            }
+            v
+        };
+        let side = |s: &SideSpec| -> Result<ContactSide, String> {
+            match *s {
+                SideSpec::Node { node } => node_index
+                    .get(&node)
+                    .map(|&i| ContactSide::Node(i))
+                    .ok_or(format!("unknown node {node}")),
+                SideSpec::Point { fiber, segment, xi } => {
+                    let f = *fiber_ids
+                        .get(&fiber)
+                        .ok_or(format!("unknown fiber {fiber}"))?;
+                    if segment + 1 >= fibers[f].nodes.len() {
+                        return Err(format!(
+                            "fiber {fiber} has no segment {segment} (it has {})",
+                            fibers[f].nodes.len() - 1
+                        ));
+                    }
+                    if !(0.0..=1.0).contains(&xi) {
+                        return Err(format!("xi = {xi} is outside [0, 1]"));
+                    }
+                    Ok(ContactSide::Point {
+                        element: first_element[f] + segment,
+                        xi,
+                    })
+                }
+            }
+        };
+        let explicit_contacts = d
+            .contacts
+            .iter()
+            .enumerate()
+            .map(|(k, c)| check_pair(k, c, &side))
+            .collect::<Result<Vec<_>, _>>()?;
+        if !explicit_contacts.is_empty() && contact.is_none() {
+            return Err(ModelError::InvalidContact {
+                item: "[[contacts]]".into(),
+                message:
+                    "explicit contact pairs need a [contact] section (friction law, penalties)"
+                        .into(),
+            });
+        }
         Ok(Model {
             name: d.name.clone(),
             nodes,
@@ -284,8 +348,11 @@ impl Model {
             fibers,
             supports,
             loads,
+            contact,
+            explicit_contacts,
             elements,
             node_index,
+            contact_specs: (d.contact.clone(), d.contacts.clone()),
         })
     }
 
@@ -385,6 +452,13 @@ impl Model {
                 })
                 .collect(),
             loads,
+            contact: self.contact_specs.0.clone(),
+            contacts: self.contact_specs.1.clone(),
         }
+    }
+
+    /// Whether the model has contact (settings present).
+    pub fn has_contact(&self) -> bool {
+        self.contact.is_some()
     }
 }

@@ -61,6 +61,7 @@ pub fn cantilever(
             force,
             moment,
         }],
+        ..Default::default()
     }
 }
 
