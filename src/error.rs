@@ -37,6 +37,19 @@ pub enum Error {
     /// The stiffness pattern does not fit the 32-bit slot map.
     #[error(transparent)]
     PatternTooLarge(#[from] crate::assembly::PatternTooLargeError),
+    /// The stick/slip iterations of an increment did not settle.
+    #[error("increment {step}: contact states still switching after {iterations} iterations ({} contact{}: {})", contacts.len(), if contacts.len() == 1 { "" } else { "s" }, contacts.iter().take(10).cloned().collect::<Vec<_>>().join("; "))]
+    ContactNotConverged {
+        /// Increment (1-based).
+        step: usize,
+        /// Iterations done.
+        iterations: usize,
+        /// The contacts that kept switching, described.
+        contacts: Vec<String>,
+    },
+    /// An option is out of range.
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
     /// Writing an output failed.
     #[error("cannot write {path}: {message}")]
     Output {

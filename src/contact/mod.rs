@@ -6,6 +6,7 @@ mod geometry;
 mod kinematics;
 mod law;
 mod search;
+mod set;
 
 pub use geometry::{closest_points, ClosestPoints};
 pub use kinematics::{centerline_interpolation, jump_operator, ContactSide, Jump, JumpMatrix};
@@ -13,3 +14,4 @@ pub use law::{
     tangent_basis, BlockMatrix, BlockVector, ContactPair, ContactState, Friction, PairKinematics,
 };
 pub use search::{find_candidates, find_candidates_brute_force, Candidate};
+pub use set::{default_penalty, ContactOrigin, ContactSet, PenetrationReport};

@@ -15,12 +15,26 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
 /// Fails with [`Error::Unsupported`] naming the fibers of the first group (in fiber order)
 /// that no support touches.
 pub fn check_supported(model: &Model) -> Result<(), Error> {
+    check_supported_with(model, &[])
+}
+
+/// Like [`check_supported`], with extra groups of nodes joined (the blocks of the contacts that
+/// are currently closed): a fiber held only by open contacts is reported.
+pub fn check_supported_with(model: &Model, links: &[&[usize]]) -> Result<(), Error> {
     let n = model.nodes.len();
     let mut parent: Vec<usize> = (0..n).collect();
-    for e in model.elements() {
-        let (a, b) = (find(&mut parent, e.nodes[0]), find(&mut parent, e.nodes[1]));
+    let join = |parent: &mut Vec<usize>, x: usize, y: usize| {
+        let (a, b) = (find(parent, x), find(parent, y));
         if a != b {
             parent[a.max(b)] = a.min(b);
+        }
+    };
+    for e in model.elements() {
+        join(&mut parent, e.nodes[0], e.nodes[1]);
+    }
+    for group in links {
+        for w in group.windows(2) {
+            join(&mut parent, w[0], w[1]);
         }
     }
     let mut supported = vec![false; n];

@@ -2,10 +2,14 @@
 
 mod backend;
 mod connectivity;
+mod incremental;
 mod reduced;
 mod static_solve;
 
 pub use backend::{make_solver, SolverKind};
-pub use connectivity::check_supported;
+pub use connectivity::{check_supported, check_supported_with};
+pub use incremental::{
+    solve_incremental, ContactRecord, IncrementRecord, IncrementalOptions, IncrementalSolution,
+};
 pub use reduced::ReducedSystem;
 pub use static_solve::{solve_static, SolveOptions, SolveSummary, StaticSolution, Timings};

@@ -78,10 +78,10 @@ pub struct StaticSolution {
 }
 
 /// Maps a pivot failure at a reduced column to the node, DOF and fibers.
-fn locate(e: SolverError, model: &Model, sys: &ReducedSystem) -> Error {
+pub(super) fn locate(e: SolverError, model: &Model, dofs: &crate::assembly::DofMap) -> Error {
     match e {
-        SolverError::NotPositiveDefinite { column, pivot } if column < sys.dofs.n_free() => {
-            let (node, dof) = sys.dofs.node_dof(column);
+        SolverError::NotPositiveDefinite { column, pivot } if column < dofs.n_free() => {
+            let (node, dof) = dofs.node_dof(column);
             Error::Singular {
                 node: model.nodes[node].id,
                 dof,
@@ -120,14 +120,16 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
             sys.dofs.node_block_starts(),
         )?;
         let t = Instant::now();
-        let info = solver.analyze(a).map_err(|e| locate(e, model, &sys))?;
+        let info = solver.analyze(a).map_err(|e| locate(e, model, &sys.dofs))?;
         timings.analyze = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        solver.factorize(a).map_err(|e| locate(e, model, &sys))?;
+        solver
+            .factorize(a)
+            .map_err(|e| locate(e, model, &sys.dofs))?;
         timings.factorize = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let (mut x, mut report) =
-            solve_checked(solver.as_mut(), a, &sys.rhs, 1).map_err(|e| locate(e, model, &sys))?;
+        let (mut x, mut report) = solve_checked(solver.as_mut(), a, &sys.rhs, 1)
+            .map_err(|e| locate(e, model, &sys.dofs))?;
         // Iterative refinement with the same factor: x += A⁻¹(b − A x), while it helps.
         for _ in 0..2 {
             if report.relative_residual <= 1e-13 || report.info.iterations.is_some() {
@@ -138,8 +140,8 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
             r.iter_mut()
                 .zip(&sys.rhs)
                 .for_each(|(ri, bi)| *ri = bi - *ri);
-            let (dx, _) =
-                solve_checked(solver.as_mut(), a, &r, 1).map_err(|e| locate(e, model, &sys))?;
+            let (dx, _) = solve_checked(solver.as_mut(), a, &r, 1)
+                .map_err(|e| locate(e, model, &sys.dofs))?;
             let refined: Vec<f64> = x.iter().zip(&dx).map(|(p, q)| p + q).collect();
             let res = fibercell_solver::relative_residual(a, &refined, &sys.rhs);
             if !(res < report.relative_residual) {

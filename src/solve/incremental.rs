@@ -1,0 +1,496 @@
+//! The incremental stick/slip solver (thesis §4.3 "Contact solution algorithm"): the load is
+//! applied in N increments α_n = n/N; all closed contacts start in stick; inside each increment
+//! the contact contributions are rebuilt for the current states, the system is solved, and every
+//! contact is re-classified by a return mapping — open if it does not penetrate, stick if the
+//! trial tangential force p_T (Eᵀ B q − s) lies within the friction bound (μN or G), otherwise
+//! slip at the bound along the trial direction — until no state changes.
+//!
+//! The pattern (elements ∪ all candidate contact blocks) and each backend's symbolic analysis are
+//! built once; a factorization is redone only when the assembled values changed. Systems with a
+//! Coulomb-sliding contact are nonsymmetric and go to LU, all others to the chosen symmetric
+//! backend.
+
+use super::static_solve::locate;
+use super::{check_supported_with, make_solver, SolveOptions, SolverKind};
+use crate::assembly::{Assembler, DofMap, Pattern};
+use crate::constraints::{internal_forces, reduced_rhs, Reaction};
+use crate::contact::{BlockVector, ContactPair, ContactSet, ContactSide, ContactState, Friction};
+use crate::model::Model;
+use crate::Error;
+use fibercell_solver::{solve_checked, LinearSolver, SolverError};
+use nalgebra::{Vector2, Vector3};
+use serde::Serialize;
+
+/// Options of [`solve_incremental`].
+#[derive(Clone, Debug)]
+pub struct IncrementalOptions {
+    /// Number of load increments N ≥ 1.
+    pub steps: usize,
+    /// Backend and checks for the symmetric systems (Coulomb sliding always uses faer LU).
+    pub solve: SolveOptions,
+    /// Largest number of state iterations inside one increment.
+    pub max_state_iterations: usize,
+}
+
+impl Default for IncrementalOptions {
+    fn default() -> Self {
+        IncrementalOptions {
+            steps: 10,
+            solve: SolveOptions::default(),
+            max_state_iterations: 50,
+        }
+    }
+}
+
+/// One increment.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct IncrementRecord {
+    /// Increment n (1-based).
+    pub step: usize,
+    /// Load factor α = n/N.
+    pub alpha: f64,
+    /// State iterations needed.
+    pub iterations: usize,
+    /// Numeric factorizations done in this increment.
+    pub factorizations: usize,
+    /// Contacts open, stuck and sliding at the end of the increment.
+    pub open: usize,
+    /// Stuck contacts.
+    pub stick: usize,
+    /// Sliding contacts.
+    pub slip: usize,
+    /// Applied nodal loads summed per DOF (Fx, Fy, Fz, Mx, My, Mz), times α.
+    pub applied_load: [f64; 6],
+    /// Support reactions summed per DOF.
+    pub reaction: [f64; 6],
+    /// Backend of the last solve.
+    pub backend: String,
+    /// Backward error of the last solve.
+    pub backward_error: f64,
+}
+
+/// One contact at the end of an increment.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ContactRecord {
+    /// open, stick or slip.
+    #[serde(serialize_with = "state_name")]
+    pub state: ContactState,
+    /// Current gap ḡ − nᵀ[u] (m; negative: penetration, which the penalty allows).
+    pub gap: f64,
+    /// Normal force N ≥ 0 (N).
+    pub normal_force: f64,
+    /// Tangential force vector in global coordinates (N).
+    pub tangential_force: [f64; 3],
+    /// Its magnitude (N).
+    pub tangential_magnitude: f64,
+    /// The friction bound μN or G at this state (N).
+    pub friction_bound: f64,
+}
+
+fn state_name<S: serde::Serializer>(s: &ContactState, ser: S) -> Result<S::Ok, S::Error> {
+    ser.serialize_str(s.name())
+}
+
+/// Results of every increment.
+#[derive(Clone, Debug)]
+pub struct IncrementalSolution {
+    /// The contact pairs.
+    pub contacts: ContactSet,
+    /// Per-increment summary.
+    pub increments: Vec<IncrementRecord>,
+    /// Per increment, every contact.
+    pub contact_results: Vec<Vec<ContactRecord>>,
+    /// Per increment, [ux, uy, uz, rx, ry, rz] of every node.
+    pub displacements: Vec<Vec<[f64; 6]>>,
+    /// Reactions at the end.
+    pub reactions: Vec<Reaction>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Trial {
+    state: ContactState,
+    direction: Vector2<f64>,
+    normal_force: f64,
+    tangential: Vector2<f64>,
+    bound: f64,
+    relative: Vector2<f64>,
+    penetration: f64,
+}
+
+/// Return mapping of one contact for the block displacement `q` and committed slip `s`.
+/// `previous` is the state the system was solved with: within the tolerances (`length_tol` on
+/// the penetration, a relative 1e-10 on the friction bound) a contact keeps it, so a contact
+/// exactly at the switch point does not flip back and forth.
+fn classify(
+    pair: &ContactPair,
+    friction: Friction,
+    q: &BlockVector,
+    slip: &Vector2<f64>,
+    previous: ContactState,
+    length_tol: f64,
+) -> Trial {
+    let kin = pair.kinematics(q);
+    let mut t = Trial {
+        state: ContactState::Open,
+        direction: Vector2::zeros(),
+        normal_force: 0.0,
+        tangential: Vector2::zeros(),
+        bound: 0.0,
+        relative: kin.tangential,
+        penetration: kin.penetration,
+    };
+    let closed_before = previous != ContactState::Open;
+    let closes = if closed_before {
+        kin.penetration > -length_tol
+    } else {
+        kin.penetration > length_tol
+    };
+    if !closes {
+        return t;
+    }
+    t.normal_force = pair.penalty_normal * kin.penetration.max(0.0);
+    let trial = (kin.tangential - slip) * pair.penalty_tangent;
+    let norm = trial.norm();
+    t.direction = if norm > 0.0 {
+        trial / norm
+    } else {
+        Vector2::zeros()
+    };
+    t.bound = match friction {
+        Friction::None => 0.0,
+        Friction::Coulomb { mu } => mu * t.normal_force,
+        Friction::Tresca { bound } => bound,
+    };
+    let margin = if previous == ContactState::Slip {
+        1.0 - 1e-10
+    } else {
+        1.0 + 1e-10
+    };
+    if friction != Friction::None && norm <= t.bound * margin {
+        t.state = ContactState::Stick;
+        t.tangential = trial;
+    } else {
+        t.state = ContactState::Slip;
+        t.tangential = t.direction * t.bound;
+    }
+    t
+}
+
+fn describe(model: &Model, set: &ContactSet, i: usize) -> String {
+    let o = &set.origins[i];
+    let side = |s: ContactSide| match s {
+        ContactSide::Node(n) => format!("node {}", model.nodes[n].id),
+        ContactSide::Point { element, xi } => {
+            let e = model.elements()[element];
+            format!(
+                "fiber {} at nodes {}–{} ξ={xi:.3}",
+                model.fibers[e.fiber].id, model.nodes[e.nodes[0]].id, model.nodes[e.nodes[1]].id
+            )
+        }
+    };
+    format!(
+        "contact {} ({} / {})",
+        i + 1,
+        side(o.sides[0]),
+        side(o.sides[1])
+    )
+}
+
+/// Diagonal of the model's bounding box.
+fn model_size(model: &Model) -> f64 {
+    let (lo, hi) = model
+        .nodes
+        .iter()
+        .fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), n| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(n.x[k])),
+                [0, 1, 2].map(|k| hi[k].max(n.x[k])),
+            )
+        });
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
+struct Backends {
+    symmetric: Option<Box<dyn LinearSolver>>,
+    general: Option<Box<dyn LinearSolver>>,
+}
+
+/// Runs the incremental stick/slip analysis of `model` (its supports, loads and contacts).
+pub fn solve_incremental(
+    model: &Model,
+    opts: &IncrementalOptions,
+) -> Result<IncrementalSolution, Error> {
+    if opts.steps == 0 {
+        return Err(Error::InvalidOption(
+            "the number of increments must be at least 1".into(),
+        ));
+    }
+    if opts.max_state_iterations == 0 {
+        return Err(Error::InvalidOption(
+            "max_state_iterations must be at least 1".into(),
+        ));
+    }
+    let set = ContactSet::build(model)?;
+    let friction = model
+        .contact
+        .as_ref()
+        .map_or(Friction::None, |c| c.friction);
+    let dofs = DofMap::new(model);
+    let pattern = Pattern::with_blocks(model, &dofs, &set.blocks())?;
+    let mut k_elastic = vec![0.0; pattern.nnz()];
+    Assembler::new(model).fill(model, &pattern, &mut k_elastic, opts.solve.fill)?;
+    let rhs_full = reduced_rhs(model, &dofs);
+    let n_free = dofs.n_free();
+    let mut applied_full = [0.0; 6];
+    for l in &model.loads {
+        applied_full[l.dof.index()] += l.value;
+    }
+    let mut backends = Backends {
+        symmetric: None,
+        general: None,
+    };
+    let max_bwd = if opts.solve.max_backward_error > 0.0 {
+        opts.solve.max_backward_error
+    } else {
+        1e-10
+    };
+
+    // Contact states: closed pairs start in stick (thesis step 1), others open.
+    let initial = |p: &ContactPair| {
+        if p.gap <= 0.0 {
+            if friction == Friction::None {
+                ContactState::Slip
+            } else {
+                ContactState::Stick
+            }
+        } else {
+            ContactState::Open
+        }
+    };
+    let mut states: Vec<ContactState> = set.pairs.iter().map(initial).collect();
+    let mut directions: Vec<Vector2<f64>> = vec![Vector2::zeros(); set.pairs.len()];
+    let mut slips: Vec<Vector2<f64>> = vec![Vector2::zeros(); set.pairs.len()];
+    // What the current factorization was built from (None: nothing factorized yet).
+    let mut factorized: Option<(bool, Vec<ContactState>, Vec<Vector2<f64>>)> = None;
+
+    let length_tol = 1e-12 * model_size(model);
+    let mut values = k_elastic.clone();
+    let mut u = vec![0.0; dofs.n_global()];
+    let mut out = IncrementalSolution {
+        contacts: set.clone(),
+        increments: Vec::with_capacity(opts.steps),
+        contact_results: Vec::with_capacity(opts.steps),
+        displacements: Vec::with_capacity(opts.steps),
+        reactions: Vec::new(),
+    };
+    let gather = |u: &[f64], nodes: &[usize]| {
+        let mut q = BlockVector::zeros();
+        for (k, &n) in nodes.iter().enumerate() {
+            for d in 0..6 {
+                q[6 * k + d] = u[6 * n + d];
+            }
+        }
+        q
+    };
+
+    for step in 1..=opts.steps {
+        let alpha = step as f64 / opts.steps as f64;
+        let prescribed = |g: usize| alpha * dofs.prescribed_value(g);
+        let mut factorizations = 0;
+        let mut converged = None;
+        for iteration in 1..=opts.max_state_iterations {
+            // Assemble K + K_N + K_T and α F + F_N + F_T for the current states.
+            values.copy_from_slice(&k_elastic);
+            let mut rhs: Vec<f64> = rhs_full.iter().map(|v| alpha * v).collect();
+            let mut closed: Vec<&[usize]> = Vec::new();
+            let mut nonsymmetric = false;
+            for (i, pair) in set.pairs.iter().enumerate() {
+                if states[i] == ContactState::Open {
+                    continue;
+                }
+                closed.push(&pair.jump.nodes);
+                let (mut k, mut f) = pair.normal();
+                let (kt, ft) = match states[i] {
+                    ContactState::Stick => pair.stick(&slips[i]),
+                    _ => {
+                        nonsymmetric |= matches!(friction, Friction::Coulomb { mu } if mu > 0.0);
+                        pair.slip(friction, &directions[i])
+                    }
+                };
+                k += kt;
+                f += ft;
+                let m = pair.size();
+                let slots = pattern.extra_slots(i);
+                let globals = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
+                for r in 0..m {
+                    let gr = globals(r);
+                    let Some(ir) = dofs.reduced(gr) else { continue };
+                    rhs[ir] += f[r];
+                    for c in 0..m {
+                        let s = slots[r * m + c];
+                        if s != crate::assembly::NO_SLOT {
+                            values[s as usize] += k[(r, c)];
+                        } else if dofs.reduced(globals(c)).is_none() {
+                            rhs[ir] -= k[(r, c)] * prescribed(globals(c));
+                        }
+                    }
+                }
+            }
+            check_supported_with(model, &closed)?;
+            let a = pattern.matrix(&values)?;
+            let (slot, kind) = if nonsymmetric {
+                (&mut backends.general, SolverKind::FaerLu)
+            } else {
+                (&mut backends.symmetric, opts.solve.solver)
+            };
+            if slot.is_none() {
+                let mut s = make_solver(kind, &opts.solve.ordering, dofs.node_block_starts())?;
+                s.analyze(a).map_err(|e| locate(e, model, &dofs))?;
+                *slot = Some(s);
+            }
+            let solver = slot
+                .as_mut()
+                .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "analyze")))?;
+            let key = (nonsymmetric, states.clone(), directions.clone());
+            if factorized.as_ref() != Some(&key) {
+                solver.factorize(a).map_err(|e| locate(e, model, &dofs))?;
+                factorizations += 1;
+                factorized = Some(key);
+            }
+            let (x, report) = if n_free == 0 {
+                (Vec::new(), None)
+            } else {
+                let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1)
+                    .map_err(|e| locate(e, model, &dofs))?;
+                (x, Some(r))
+            };
+            let bwd = report.as_ref().map_or(0.0, |r| r.backward_error);
+            if !(bwd <= max_bwd) {
+                return Err(Error::Solver(SolverError::Singular {
+                    column: None,
+                    detail: format!(
+                        "increment {step}: backward error {bwd:.3e} exceeds {max_bwd:.1e}"
+                    ),
+                }));
+            }
+            for (g, ug) in u.iter_mut().enumerate() {
+                *ug = match dofs.reduced(g) {
+                    Some(r) => x[r],
+                    None => prescribed(g),
+                };
+            }
+            // Return mapping of every contact.
+            let trials: Vec<Trial> = set
+                .pairs
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    classify(
+                        p,
+                        friction,
+                        &gather(&u, &p.jump.nodes),
+                        &slips[i],
+                        states[i],
+                        length_tol,
+                    )
+                })
+                .collect();
+            let changed: Vec<usize> = (0..set.pairs.len())
+                .filter(|&i| {
+                    let t = &trials[i];
+                    t.state != states[i]
+                        || (t.state == ContactState::Slip
+                            && friction != Friction::None
+                            && (t.direction - directions[i]).norm() > 1e-9)
+                })
+                .collect();
+            if changed.is_empty() {
+                converged = Some((iteration, trials, report.map(|r| (r.backend, bwd))));
+                break;
+            }
+            if iteration == opts.max_state_iterations {
+                return Err(Error::ContactNotConverged {
+                    step,
+                    iterations: iteration,
+                    contacts: changed.iter().map(|&i| describe(model, &set, i)).collect(),
+                });
+            }
+            for &i in &changed {
+                states[i] = trials[i].state;
+                directions[i] = trials[i].direction;
+            }
+        }
+        let Some((iterations, trials, report)) = converged else {
+            return Err(Error::InvalidOption("no state iteration ran".into()));
+        };
+        // Commit the slip history and record the increment.
+        let mut records = Vec::with_capacity(set.pairs.len());
+        let mut contact_forces = vec![0.0; dofs.n_global()];
+        for (i, (pair, t)) in set.pairs.iter().zip(&trials).enumerate() {
+            match t.state {
+                ContactState::Open => slips[i] = t.relative,
+                ContactState::Slip => slips[i] = t.relative - t.tangential / pair.penalty_tangent,
+                ContactState::Stick => {}
+            }
+            let ft: Vector3<f64> =
+                pair.tangents[0] * t.tangential[0] + pair.tangents[1] * t.tangential[1];
+            let force = pair.normal * t.normal_force + ft;
+            let fq = pair.jump.b.transpose() * force;
+            for (k, &n) in pair.jump.nodes.iter().enumerate() {
+                for d in 0..6 {
+                    contact_forces[6 * n + d] += fq[6 * k + d];
+                }
+            }
+            records.push(ContactRecord {
+                state: t.state,
+                gap: -t.penetration,
+                normal_force: t.normal_force,
+                tangential_force: [ft[0], ft[1], ft[2]],
+                tangential_magnitude: ft.norm(),
+                friction_bound: t.bound,
+            });
+        }
+        let internal = internal_forces(model, &u);
+        let mut reaction = [0.0; 6];
+        let mut reactions = Vec::with_capacity(model.supports.len());
+        for s in &model.supports {
+            let g = DofMap::global(s.node, s.dof);
+            let load: f64 = model
+                .loads
+                .iter()
+                .filter(|l| l.node == s.node && l.dof == s.dof)
+                .map(|l| alpha * l.value)
+                .sum();
+            let value = internal[g] + contact_forces[g] - load;
+            reaction[s.dof.index()] += value;
+            reactions.push(Reaction {
+                node: s.node,
+                dof: s.dof,
+                value,
+            });
+        }
+        let count = |s: ContactState| records.iter().filter(|r| r.state == s).count();
+        let (backend, bwd) = report.unwrap_or(("none", 0.0));
+        out.increments.push(IncrementRecord {
+            step,
+            alpha,
+            iterations,
+            factorizations,
+            open: count(ContactState::Open),
+            stick: count(ContactState::Stick),
+            slip: count(ContactState::Slip),
+            applied_load: applied_full.map(|v| alpha * v),
+            reaction,
+            backend: backend.to_string(),
+            backward_error: bwd,
+        });
+        out.contact_results.push(records);
+        out.displacements.push(
+            u.chunks(6)
+                .map(|c| [c[0], c[1], c[2], c[3], c[4], c[5]])
+                .collect(),
+        );
+        out.reactions = reactions;
+    }
+    Ok(out)
+}
