@@ -1,7 +1,9 @@
 //! The `fibercell` command line: a thin shell over the library.
 
 use clap::{Parser, Subcommand};
-use fibercell::solve::{solve_static, SolveOptions, SolverKind};
+use fibercell::solve::{
+    solve_incremental, solve_static, IncrementalOptions, SolveOptions, SolverKind,
+};
 use fibercell::solver::Ordering;
 use fibercell::{io, Error};
 use std::path::{Path, PathBuf};
@@ -33,7 +35,10 @@ enum Command {
         /// Print one JSON document (displacements, reactions, solver report) to stdout.
         #[arg(long)]
         json: bool,
-        /// Directory for displacements.csv, displacements.json and deformed.vtu.
+        /// Load increments of the stick/slip solver (models with contact).
+        #[arg(long, default_value_t = 10)]
+        steps: usize,
+        /// Directory for the results (CSV, JSON, VTK).
         #[arg(short, long, default_value = "fibercell-results")]
         output: PathBuf,
     },
@@ -63,73 +68,160 @@ fn parse_ordering(s: &str) -> Result<Ordering, String> {
     }
 }
 
+fn write(path: &Path, contents: &str) -> Result<(), Error> {
+    io::write_atomic(path, contents.as_bytes())
+}
+
+fn to_pretty(doc: &serde_json::Value) -> Result<String, Error> {
+    serde_json::to_string_pretty(doc).map_err(|e| Error::Output {
+        path: "json".into(),
+        message: e.to_string(),
+    })
+}
+
 fn solve(
     model_path: &Path,
-    solver: SolverKind,
-    ordering: Ordering,
+    options: SolveOptions,
+    steps: usize,
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
-    let options = SolveOptions {
-        solver,
-        ordering,
-        ..SolveOptions::default()
-    };
-    let sol = solve_static(&model, &options)?;
-    let doc = io::solution_json(&model, &sol);
-    let pretty = serde_json::to_string_pretty(&doc).map_err(|e| Error::Output {
-        path: "stdout".into(),
-        message: e.to_string(),
-    })?;
     std::fs::create_dir_all(out).map_err(|e| Error::Output {
         path: out.display().to_string(),
         message: e.to_string(),
     })?;
-    io::write_atomic(
+    if model.has_contact() {
+        return solve_with_contact(model_path, &model, options, steps, json, out);
+    }
+    let sol = solve_static(&model, &options)?;
+    let pretty = to_pretty(&io::solution_json(&model, &sol))?;
+    write(
         &out.join("displacements.csv"),
-        io::displacements_csv(&model, &sol).as_bytes(),
+        &io::displacements_csv(&model, &sol.displacements),
     )?;
-    io::write_atomic(&out.join("displacements.json"), pretty.as_bytes())?;
-    io::write_atomic(
+    write(&out.join("displacements.json"), &pretty)?;
+    write(
         &out.join("deformed.vtu"),
-        io::deformed_vtu(&model, &sol).as_bytes(),
+        &io::deformed_vtu(&model, &sol.displacements),
     )?;
     if json {
         println!("{pretty}");
-    } else {
-        let s = &sol.summary;
-        let max_u = sol
-            .displacements
-            .iter()
-            .map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt())
-            .fold(0.0, f64::max);
+        return Ok(());
+    }
+    let s = &sol.summary;
+    print_model_line(model_path, &model, s.free_dofs);
+    println!(
+        "solver {} (ordering {}): nnz(K) {}, nnz(L) {}, relative residual {:.2e}, backward error {:.2e}",
+        s.backend,
+        s.ordering,
+        s.nnz,
+        s.nnz_factor.map_or("-".into(), |v| v.to_string()),
+        s.relative_residual,
+        s.backward_error
+    );
+    println!(
+        "time: pattern {:.3} s, fill {:.3} s, analyze {:.3} s, factorize {:.3} s, solve {:.3} s",
+        s.timings.pattern, s.timings.fill, s.timings.analyze, s.timings.factorize, s.timings.solve
+    );
+    println!(
+        "largest displacement {:.6e} m; results in {}",
+        largest(&sol.displacements),
+        out.display()
+    );
+    Ok(())
+}
+
+fn print_model_line(path: &Path, model: &fibercell::Model, free: usize) {
+    println!(
+        "{}: {} nodes, {} fibers, {} elements, {} free DOFs",
+        path.display(),
+        model.nodes.len(),
+        model.fibers.len(),
+        model.elements().len(),
+        free
+    );
+}
+
+fn largest(d: &[[f64; 6]]) -> f64 {
+    d.iter()
+        .map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt())
+        .fold(0.0, f64::max)
+}
+
+fn solve_with_contact(
+    model_path: &Path,
+    model: &fibercell::Model,
+    solve: SolveOptions,
+    steps: usize,
+    json: bool,
+    out: &Path,
+) -> Result<(), Error> {
+    let opts = IncrementalOptions {
+        steps,
+        solve,
+        ..IncrementalOptions::default()
+    };
+    let sol = solve_incremental(model, &opts)?;
+    let last = sol.increments.len().saturating_sub(1);
+    let pretty = to_pretty(&io::incremental_json(model, &sol))?;
+    let final_u = sol.displacements.last().map(|d| &d[..]).unwrap_or(&[]);
+    write(
+        &out.join("displacements.csv"),
+        &io::displacements_csv(model, final_u),
+    )?;
+    write(&out.join("displacements.json"), &pretty)?;
+    write(&out.join("increments.csv"), &io::increments_csv(&sol))?;
+    write(&out.join("contacts.csv"), &io::contacts_csv(&sol, last))?;
+    for (k, rec) in sol.increments.iter().enumerate() {
+        write(
+            &out.join(io::step_file("step", rec.step)),
+            &io::deformed_vtu(model, &sol.displacements[k]),
+        )?;
+        write(
+            &out.join(io::step_file("contacts", rec.step)),
+            &io::contacts_vtu(&sol, k),
+        )?;
+    }
+    write(&out.join("solution.pvd"), &io::series_pvd(&sol))?;
+    if json {
+        println!("{pretty}");
+        return Ok(());
+    }
+    print_model_line(
+        model_path,
+        model,
+        6 * model.nodes.len() - model.supports.len(),
+    );
+    let p = sol.contacts.penetration;
+    println!("{} contact pairs", sol.contacts.pairs.len());
+    if p.count > 0 {
         println!(
-            "{}: {} nodes, {} fibers, {} elements, {} free DOFs",
-            model_path.display(),
-            model.nodes.len(),
-            model.fibers.len(),
-            model.elements().len(),
-            s.free_dofs
-        );
-        println!(
-            "solver {} (ordering {}): nnz(K) {}, nnz(L) {}, relative residual {:.2e}, backward error {:.2e}",
-            s.backend,
-            s.ordering,
-            s.nnz,
-            s.nnz_factor.map_or("-".into(), |v| v.to_string()),
-            s.relative_residual,
-            s.backward_error
-        );
-        println!(
-            "time: pattern {:.3} s, fill {:.3} s, analyze {:.3} s, factorize {:.3} s, solve {:.3} s",
-            s.timings.pattern, s.timings.fill, s.timings.analyze, s.timings.factorize, s.timings.solve
-        );
-        println!(
-            "largest displacement {max_u:.6e} m; results in {}",
-            out.display()
+            "{} pairs start penetrating (worst overlap {:.3e} m): {}",
+            p.count,
+            p.worst_overlap,
+            if p.adjusted {
+                "gaps set to zero (strain-free)"
+            } else {
+                "resolved by the penalty over the increments"
+            }
         );
     }
+    println!(
+        "{:>5} {:>8} {:>5} {:>6} {:>6} {:>6}",
+        "step", "alpha", "iter", "open", "stick", "slip"
+    );
+    for r in &sol.increments {
+        println!(
+            "{:>5} {:>8.4} {:>5} {:>6} {:>6} {:>6}",
+            r.step, r.alpha, r.iterations, r.open, r.stick, r.slip
+        );
+    }
+    println!(
+        "largest displacement {:.6e} m; results in {}",
+        largest(final_u),
+        out.display()
+    );
     Ok(())
 }
 
@@ -154,9 +246,20 @@ fn main() -> ExitCode {
             model,
             solver,
             ordering,
+            steps,
             json,
             output,
-        } => solve(&model, solver, ordering, json, &output),
+        } => solve(
+            &model,
+            SolveOptions {
+                solver,
+                ordering,
+                ..SolveOptions::default()
+            },
+            steps,
+            json,
+            &output,
+        ),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
     };
     match r {

@@ -14,8 +14,10 @@ pub use atomic::write_atomic;
 pub use error::InputError;
 pub use matrix_market::write_matrix_market;
 pub use native::{parse_json, parse_toml, to_json, to_toml};
-pub use results::{displacements_csv, solution_json};
-pub use vtk::deformed_vtu;
+pub use results::{
+    contacts_csv, displacements_csv, incremental_json, increments_csv, solution_json,
+};
+pub use vtk::{contacts_vtu, deformed_vtu, series_pvd, step_file};
 
 use crate::model::{Model, ModelDescription};
 use crate::Error;

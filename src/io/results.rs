@@ -1,14 +1,16 @@
 //! Nodal results as CSV and JSON.
 
+use crate::constraints::Reaction;
+use crate::contact::ContactSide;
 use crate::model::Model;
-use crate::solve::StaticSolution;
+use crate::solve::{IncrementalSolution, StaticSolution};
 use serde_json::{json, Map, Value};
 use std::fmt::Write;
 
 /// `node,ux,uy,uz,rx,ry,rz`, one line per node, full precision.
-pub fn displacements_csv(model: &Model, sol: &StaticSolution) -> String {
+pub fn displacements_csv(model: &Model, displacements: &[[f64; 6]]) -> String {
     let mut s = String::from("node,ux,uy,uz,rx,ry,rz\n");
-    for (n, u) in model.nodes.iter().zip(&sol.displacements) {
+    for (n, u) in model.nodes.iter().zip(displacements) {
         let _ = writeln!(
             s,
             "{},{:e},{:e},{:e},{:e},{:e},{:e}",
@@ -18,17 +20,25 @@ pub fn displacements_csv(model: &Model, sol: &StaticSolution) -> String {
     s
 }
 
-/// One JSON document: `displacements` keyed by node id, `reactions`, and the solver report.
-pub fn solution_json(model: &Model, sol: &StaticSolution) -> Value {
+fn displacements_map(model: &Model, displacements: &[[f64; 6]]) -> Map<String, Value> {
     let mut disp = Map::new();
-    for (n, u) in model.nodes.iter().zip(&sol.displacements) {
+    for (n, u) in model.nodes.iter().zip(displacements) {
         disp.insert(n.id.to_string(), json!(u));
     }
-    let reactions: Vec<Value> = sol
-        .reactions
+    disp
+}
+
+fn reactions_json(model: &Model, reactions: &[Reaction]) -> Vec<Value> {
+    reactions
         .iter()
         .map(|r| json!({"node": model.nodes[r.node].id, "dof": r.dof.name(), "value": r.value}))
-        .collect();
+        .collect()
+}
+
+/// One JSON document: `displacements` keyed by node id, `reactions`, and the solver report.
+pub fn solution_json(model: &Model, sol: &StaticSolution) -> Value {
+    let disp = displacements_map(model, &sol.displacements);
+    let reactions = reactions_json(model, &sol.reactions);
     json!({
         "model": model.name,
         "units": "SI (m, N, rad)",
@@ -38,5 +48,106 @@ pub fn solution_json(model: &Model, sol: &StaticSolution) -> Value {
         "displacements": disp,
         "reactions": reactions,
         "solver": sol.summary,
+    })
+}
+
+fn side_json(model: &Model, side: ContactSide) -> Value {
+    match side {
+        ContactSide::Node(n) => json!({"node": model.nodes[n].id}),
+        ContactSide::Point { element, xi } => {
+            let e = model.elements()[element];
+            json!({"fiber": model.fibers[e.fiber].id, "nodes": [model.nodes[e.nodes[0]].id, model.nodes[e.nodes[1]].id], "xi": xi})
+        }
+    }
+}
+
+/// `step,alpha,iterations,factorizations,open,stick,slip,load_*,reaction_*`, one line per
+/// increment.
+pub fn increments_csv(sol: &IncrementalSolution) -> String {
+    let mut s = String::from("step,alpha,iterations,factorizations,open,stick,slip,load_fx,load_fy,load_fz,load_mx,load_my,load_mz,reaction_fx,reaction_fy,reaction_fz,reaction_mx,reaction_my,reaction_mz\n");
+    for r in &sol.increments {
+        let _ = write!(
+            s,
+            "{},{},{},{},{},{},{}",
+            r.step, r.alpha, r.iterations, r.factorizations, r.open, r.stick, r.slip
+        );
+        for v in r.applied_load.iter().chain(&r.reaction) {
+            let _ = write!(s, ",{v:e}");
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// `contact,fiber_a,fiber_b,x,y,z,state,gap,normal_force,tangential_force,friction_bound` for the
+/// contacts at increment `step` (0-based).
+pub fn contacts_csv(sol: &IncrementalSolution, step: usize) -> String {
+    let mut s = String::from(
+        "contact,fiber_a,fiber_b,x,y,z,state,gap,normal_force,tangential_force,friction_bound\n",
+    );
+    if let Some(records) = sol.contact_results.get(step) {
+        for (i, (o, c)) in sol.contacts.origins.iter().zip(records).enumerate() {
+            let _ = writeln!(
+                s,
+                "{},{},{},{:e},{:e},{:e},{},{:e},{:e},{:e},{:e}",
+                i + 1,
+                o.fibers[0],
+                o.fibers[1],
+                o.point[0],
+                o.point[1],
+                o.point[2],
+                c.state.name(),
+                c.gap,
+                c.normal_force,
+                c.tangential_magnitude,
+                c.friction_bound
+            );
+        }
+    }
+    s
+}
+
+/// The incremental solution as one JSON document: final `displacements` and `reactions`,
+/// `increments` (one record per increment), `contacts` (every pair at the last increment) and
+/// `initial_penetration`.
+pub fn incremental_json(model: &Model, sol: &IncrementalSolution) -> Value {
+    let last = sol.displacements.last().map(|d| &d[..]).unwrap_or(&[]);
+    let contacts: Vec<Value> = match sol.contact_results.last() {
+        Some(records) => sol
+            .contacts
+            .origins
+            .iter()
+            .zip(records)
+            .enumerate()
+            .map(|(i, (o, c))| {
+                json!({
+                    "contact": i + 1,
+                    "origin": o.kind,
+                    "a": side_json(model, o.sides[0]),
+                    "b": side_json(model, o.sides[1]),
+                    "point": o.point,
+                    "state": c.state.name(),
+                    "gap": c.gap,
+                    "normal_force": c.normal_force,
+                    "tangential_force": c.tangential_force,
+                    "tangential_magnitude": c.tangential_magnitude,
+                    "friction_bound": c.friction_bound,
+                })
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let p = sol.contacts.penetration;
+    json!({
+        "model": model.name,
+        "units": "SI (m, N, rad)",
+        "nodes": model.nodes.len(),
+        "fibers": model.fibers.len(),
+        "elements": model.elements().len(),
+        "displacements": displacements_map(model, last),
+        "reactions": reactions_json(model, &sol.reactions),
+        "increments": sol.increments,
+        "contacts": contacts,
+        "initial_penetration": {"count": p.count, "worst_overlap": p.worst_overlap, "adjusted": p.adjusted},
     })
 }
