@@ -1,0 +1,186 @@
+//! Properties of the contact formulation and search (proptest): K_N and K_T^st symmetric
+//! positive semi-definite, only K_T^sl nonsymmetric, open contacts inert, penetration ∝ 1/penalty,
+//! and the grid search equal to the all-pairs search.
+
+use fibercell::contact::{
+    find_candidates, find_candidates_brute_force, jump_operator, tangent_basis, ContactPair,
+    ContactSide, Friction,
+};
+use fibercell::model::{FiberSpec, MaterialSpec, ModelDescription, NodeSpec};
+use fibercell::solve::{solve_incremental, solve_static, IncrementalOptions, SolveOptions};
+use fibercell::{io, Model};
+use nalgebra::{DMatrix, SymmetricEigen, Vector2, Vector3};
+use proptest::prelude::*;
+use std::path::Path;
+
+fn material() -> MaterialSpec {
+    MaterialSpec {
+        name: "m".into(),
+        young: 1e9,
+        poisson: Some(0.3),
+        shear: None,
+    }
+}
+
+/// Straight fibers given by end points, each split into `sub` elements.
+fn fibers(lines: &[([f64; 3], [f64; 3], f64)], sub: usize) -> ModelDescription {
+    let mut d = ModelDescription {
+        materials: vec![material()],
+        ..Default::default()
+    };
+    let mut id = 0u64;
+    for (f, (a, b, r)) in lines.iter().enumerate() {
+        let mut ids = Vec::new();
+        for k in 0..=sub {
+            let t = k as f64 / sub as f64;
+            id += 1;
+            d.nodes.push(NodeSpec {
+                id,
+                x: [0, 1, 2].map(|i| a[i] + t * (b[i] - a[i])),
+            });
+            ids.push(id);
+        }
+        d.fibers.push(FiberSpec {
+            id: f as u64 + 1,
+            nodes: ids,
+            radius: *r,
+            material: "m".into(),
+        });
+    }
+    d
+}
+
+fn block(pair: &ContactPair, m: &nalgebra::SMatrix<f64, 24, 24>) -> DMatrix<f64> {
+    let n = pair.size();
+    DMatrix::from_fn(n, n, |i, j| m[(i, j)])
+}
+
+fn pair_from(model: &Model, xi: [f64; 2], normal: Vector3<f64>) -> ContactPair {
+    let sides = [
+        ContactSide::Point {
+            element: 0,
+            xi: xi[0],
+        },
+        ContactSide::Point {
+            element: 2,
+            xi: xi[1],
+        },
+    ];
+    let jump = jump_operator(model, sides[0], sides[1]).expect("disjoint");
+    ContactPair {
+        jump,
+        tangents: tangent_basis(&normal, &Vector3::new(1.0, 0.2, -0.1)),
+        normal,
+        gap: 1e-4,
+        penalty_normal: 3e5,
+        penalty_tangent: 1e5,
+    }
+}
+
+fn unit() -> impl Strategy<Value = Vector3<f64>> {
+    prop::array::uniform3(-1.0f64..1.0)
+        .prop_filter("not tiny", |v| Vector3::from(*v).norm() > 0.1)
+        .prop_map(|v| Vector3::from(v).normalize())
+}
+
+fn point() -> impl Strategy<Value = [f64; 3]> {
+    prop::array::uniform3(-1.0f64..1.0)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn normal_and_stick_blocks_are_symmetric_psd_and_coulomb_slip_is_not_symmetric(
+        a in point(), b in point(), c in point(), d in point(),
+        xi in prop::array::uniform2(0.0f64..1.0), normal in unit(), dir in 0.0f64..std::f64::consts::TAU,
+    ) {
+        prop_assume!((Vector3::from(b) - Vector3::from(a)).norm() > 0.1 && (Vector3::from(d) - Vector3::from(c)).norm() > 0.1);
+        let model = Model::from_description(&fibers(&[(a, b, 0.01), (c, d, 0.01)], 2)).unwrap();
+        let pair = pair_from(&model, xi, normal);
+        let (kn, _) = pair.normal();
+        let (kt, _) = pair.stick(&Vector2::new(1e-5, -2e-5));
+        for k in [kn, kt] {
+            let m = block(&pair, &k);
+            let scale = m.amax();
+            prop_assert!((&m - m.transpose()).amax() <= 1e-12 * scale);
+            let ev = SymmetricEigen::new(m).eigenvalues;
+            prop_assert!(ev.iter().all(|&e| e >= -1e-10 * scale), "{ev}");
+        }
+        let d = Vector2::new(dir.cos(), dir.sin());
+        let (ks, _) = pair.slip(Friction::Coulomb { mu: 0.3 }, &d);
+        let m = block(&pair, &ks);
+        // Rank one B^T E d nᵀ B: nonsymmetric because E d ⟂ n.
+        prop_assert!((&m - m.transpose()).amax() > 1e-6 * m.amax());
+        let (kt0, ft) = pair.slip(Friction::Tresca { bound: 2.0 }, &d);
+        prop_assert!(kt0.amax() == 0.0 && ft.amax() > 0.0, "Tresca slip is a load only");
+    }
+
+    #[test]
+    fn grid_search_finds_exactly_the_all_pairs_candidates(
+        lines in prop::collection::vec((point(), point(), 0.005f64..0.05), 2..12),
+        sub in 1usize..5,
+        tolerance in 0.0f64..0.05,
+    ) {
+        let lines: Vec<_> = lines.into_iter().filter(|(a, b, _)| (Vector3::from(*b) - Vector3::from(*a)).norm() > 0.05).collect();
+        prop_assume!(lines.len() >= 2);
+        let model = Model::from_description(&fibers(&lines, sub)).unwrap();
+        let fast = find_candidates(&model, tolerance);
+        let mut slow = find_candidates_brute_force(&model, tolerance);
+        slow.sort_by_key(|c| c.elements);
+        prop_assert_eq!(fast.len(), slow.len());
+        for (x, y) in fast.iter().zip(&slow) {
+            prop_assert_eq!(x.elements, y.elements);
+            prop_assert!((x.distance - y.distance).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn penetration_shrinks_like_one_over_the_penalty(p in 1e3f64..1e7) {
+        // Table 5.2's bars: penetration = ū (k/p) / (2 + k/p), k = 1000, ū = 0.01.
+        let pen = |p: f64| {
+            let mut d = io::read_description(Path::new("fixtures/ok_contact_bars1.toml")).unwrap();
+            d.contact.as_mut().unwrap().penalty_normal = Some(p);
+            let m = Model::from_description(&d).unwrap();
+            -solve_incremental(&m, &IncrementalOptions { steps: 1, ..Default::default() }).unwrap().contact_results[0][0].gap
+        };
+        let (a, b) = (pen(p), pen(10.0 * p));
+        let exact = |p: f64| 0.01 * (1000.0 / p) / (2.0 + 1000.0 / p);
+        prop_assert!((a - exact(p)).abs() <= 1e-9 * exact(p));
+        prop_assert!((b / a - exact(10.0 * p) / exact(p)).abs() < 1e-9);
+        prop_assert!(b / a < 0.1 + 0.5 * 1000.0 / p);
+    }
+}
+
+#[test]
+fn open_contacts_contribute_nothing() {
+    // The second example below the closing load: identical to the model without contact.
+    let d = io::read_description(Path::new("fixtures/ok_contact_bars2.toml")).unwrap();
+    let with = Model::from_description(&d).unwrap();
+    let sol = solve_incremental(
+        &with,
+        &IncrementalOptions {
+            steps: 5,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mut plain = d.clone();
+    plain.contact = None;
+    plain.contacts.clear();
+    let reference = solve_static(
+        &Model::from_description(&plain).unwrap(),
+        &SolveOptions::default(),
+    )
+    .unwrap();
+    for step in 0..2 {
+        // α = 0.2, 0.4: open (the gap closes at α = 0.5).
+        assert!(sol.contact_results[step][0].normal_force == 0.0);
+        let alpha = (step + 1) as f64 / 5.0;
+        for (u, r) in sol.displacements[step].iter().zip(&reference.displacements) {
+            for k in 0..6 {
+                assert!((u[k] - alpha * r[k]).abs() <= 1e-14, "{u:?} vs {r:?}");
+            }
+        }
+    }
+}
