@@ -68,3 +68,74 @@ pub fn clamped_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDes
         ..Default::default()
     }
 }
+
+/// Two layers of straight steel fibers that touch at their crossings: `k` fibers along x at
+/// z = 0 and `k` along y at z = 2r, `spacing` apart, `sub` elements between crossings, every
+/// fiber clamped at both ends, the upper layer pressed down by 1 mN per node, Coulomb friction
+/// μ = 0.3 with automatic penalties. Contacts are found by the search (k² crossings).
+pub fn crossing_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDescription {
+    use crate::model::{ContactSpec, FrictionSpec};
+    let m = (k - 1) * sub + 1;
+    let h = spacing / sub as f64;
+    let mut nodes = Vec::new();
+    let mut fibers = Vec::new();
+    let mut supports = Vec::new();
+    let mut loads = Vec::new();
+    let mut id = 0u64;
+    for layer in 0..2 {
+        for f in 0..k {
+            let mut ids = Vec::with_capacity(m);
+            for j in 0..m {
+                id += 1;
+                let (a, b) = (f as f64 * spacing, j as f64 * h);
+                let x = if layer == 0 {
+                    [b, a, 0.0]
+                } else {
+                    [a, b, 2.0 * radius]
+                };
+                nodes.push(NodeSpec { id, x });
+                ids.push(id);
+                if layer == 1 && j > 0 && j + 1 < m {
+                    loads.push(LoadSpec {
+                        node: id,
+                        force: [0.0, 0.0, -1e-3],
+                        moment: [0.0; 3],
+                    });
+                }
+            }
+            for end in [ids[0], ids[m - 1]] {
+                supports.push(SupportSpec {
+                    node: end,
+                    dofs: vec![DofSet::All],
+                    value: 0.0,
+                });
+            }
+            fibers.push(FiberSpec {
+                id: (layer * k + f) as u64 + 1,
+                nodes: ids,
+                radius,
+                material: "steel".into(),
+            });
+        }
+    }
+    ModelDescription {
+        name: Some("crossing-grid".into()),
+        materials: vec![MaterialSpec {
+            name: "steel".into(),
+            young: 2.1e11,
+            poisson: Some(0.3),
+            shear: None,
+        }],
+        nodes,
+        fibers,
+        supports,
+        loads,
+        contact: Some(ContactSpec {
+            search: true,
+            tolerance: Some(0.1 * radius),
+            friction: FrictionSpec::Coulomb { mu: 0.3 },
+            ..Default::default()
+        }),
+        contacts: Vec::new(),
+    }
+}

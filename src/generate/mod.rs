@@ -2,4 +2,4 @@
 
 mod grid;
 
-pub use grid::clamped_grid;
+pub use grid::{clamped_grid, crossing_grid};
