@@ -38,6 +38,10 @@ enum Command {
         /// Load increments of the stick/slip solver (models with contact).
         #[arg(long, default_value_t = 10)]
         steps: usize,
+        /// Slide along the directions of a frictionless pre-run (thesis Remark 4.38) instead of
+        /// the per-contact return mapping.
+        #[arg(long)]
+        fixed_slip_direction: bool,
         /// Directory for the results (CSV, JSON, VTK).
         #[arg(short, long, default_value = "fibercell-results")]
         output: PathBuf,
@@ -82,7 +86,7 @@ fn to_pretty(doc: &serde_json::Value) -> Result<String, Error> {
 fn solve(
     model_path: &Path,
     options: SolveOptions,
-    steps: usize,
+    incremental: (usize, bool),
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
@@ -92,7 +96,7 @@ fn solve(
         message: e.to_string(),
     })?;
     if model.has_contact() {
-        return solve_with_contact(model_path, &model, options, steps, json, out);
+        return solve_with_contact(model_path, &model, options, incremental, json, out);
     }
     let sol = solve_static(&model, &options)?;
     let pretty = to_pretty(&io::solution_json(&model, &sol))?;
@@ -153,13 +157,14 @@ fn solve_with_contact(
     model_path: &Path,
     model: &fibercell::Model,
     solve: SolveOptions,
-    steps: usize,
+    (steps, fixed_slip_direction): (usize, bool),
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
     let opts = IncrementalOptions {
         steps,
         solve,
+        fixed_slip_direction,
         ..IncrementalOptions::default()
     };
     let sol = solve_incremental(model, &opts)?;
@@ -247,6 +252,7 @@ fn main() -> ExitCode {
             solver,
             ordering,
             steps,
+            fixed_slip_direction,
             json,
             output,
         } => solve(
@@ -256,7 +262,7 @@ fn main() -> ExitCode {
                 ordering,
                 ..SolveOptions::default()
             },
-            steps,
+            (steps, fixed_slip_direction),
             json,
             &output,
         ),

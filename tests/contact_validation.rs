@@ -370,3 +370,44 @@ fn symmetric_backends_agree_on_contact_problems() {
         assert!((n - 2.0).abs() < 1e-8, "{kind}: {n}");
     }
 }
+
+#[test]
+fn fixed_slip_direction_variant_of_remark_4_38() {
+    // The pulled fiber slides along x either way: the thesis's frictionless pre-run gives the
+    // same direction as the return mapping, so the two variants agree.
+    let (delta, steps, mu) = (0.02, 20, 0.3);
+    let d = io::parse_toml(
+        &pulled(&format!("{{ law = \"coulomb\", mu = {mu} }}"), delta),
+        "p.toml",
+    )
+    .unwrap();
+    let m = Model::from_description(&d).unwrap();
+    let a = solve_incremental(
+        &m,
+        &IncrementalOptions {
+            steps,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let b = solve_incremental(
+        &m,
+        &IncrementalOptions {
+            steps,
+            fixed_slip_direction: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for (x, y) in a.contact_results.iter().zip(&b.contact_results) {
+        assert_eq!(x[0].state, y[0].state);
+        assert!((x[0].tangential_magnitude - y[0].tangential_magnitude).abs() <= 1e-12);
+    }
+    // Increments that change no state reuse the factorization.
+    for (k, inc) in a.increments.iter().enumerate().skip(1) {
+        let same = a.contact_results[k][0].state == a.contact_results[k - 1][0].state;
+        if same && inc.iterations == 1 {
+            assert_eq!(inc.factorizations, 0, "increment {}", inc.step);
+        }
+    }
+}

@@ -30,6 +30,10 @@ pub struct IncrementalOptions {
     pub solve: SolveOptions,
     /// Largest number of state iterations inside one increment.
     pub max_state_iterations: usize,
+    /// Thesis Remark 4.38: every contact slides along the direction of its tangential relative
+    /// displacement in a frictionless pre-run, instead of the trial direction of the return
+    /// mapping (the default, and the more faithful treatment).
+    pub fixed_slip_direction: bool,
 }
 
 impl Default for IncrementalOptions {
@@ -38,6 +42,7 @@ impl Default for IncrementalOptions {
             steps: 10,
             solve: SolveOptions::default(),
             max_state_iterations: 50,
+            fixed_slip_direction: false,
         }
     }
 }
@@ -85,6 +90,8 @@ pub struct ContactRecord {
     pub tangential_magnitude: f64,
     /// The friction bound μN or G at this state (N).
     pub friction_bound: f64,
+    /// Tangential relative displacement of the contact points, global (m).
+    pub relative_tangential: [f64; 3],
 }
 
 fn state_name<S: serde::Serializer>(s: &ContactState, ser: S) -> Result<S::Ok, S::Error> {
@@ -128,6 +135,7 @@ fn classify(
     slip: &Vector2<f64>,
     previous: ContactState,
     length_tol: f64,
+    fixed_direction: Option<Vector2<f64>>,
 ) -> Trial {
     let kin = pair.kinematics(q);
     let mut t = Trial {
@@ -171,6 +179,9 @@ fn classify(
         t.tangential = trial;
     } else {
         t.state = ContactState::Slip;
+        if let Some(d) = fixed_direction.filter(|d| d.norm() > 0.0) {
+            t.direction = d;
+        }
         t.tangential = t.direction * t.bound;
     }
     t
@@ -235,6 +246,32 @@ pub fn solve_incremental(
         .contact
         .as_ref()
         .map_or(Friction::None, |c| c.friction);
+    let fixed: Vec<Option<Vector2<f64>>> =
+        if opts.fixed_slip_direction && friction != Friction::None {
+            let mut frictionless = model.clone();
+            if let Some(c) = frictionless.contact.as_mut() {
+                c.friction = Friction::None;
+            }
+            let pre = solve_incremental(
+                &frictionless,
+                &IncrementalOptions {
+                    fixed_slip_direction: false,
+                    ..opts.clone()
+                },
+            )?;
+            let last = pre.contact_results.last().cloned().unwrap_or_default();
+            set.pairs
+                .iter()
+                .zip(&last)
+                .map(|(p, r)| {
+                    let g = Vector3::from(r.relative_tangential);
+                    let d = Vector2::new(p.tangents[0].dot(&g), p.tangents[1].dot(&g));
+                    (d.norm() > 0.0).then(|| d / d.norm())
+                })
+                .collect()
+        } else {
+            vec![None; set.pairs.len()]
+        };
     let dofs = DofMap::new(model);
     let pattern = Pattern::with_blocks(model, &dofs, &set.blocks())?;
     let mut k_elastic = vec![0.0; pattern.nnz()];
@@ -392,6 +429,7 @@ pub fn solve_incremental(
                         &slips[i],
                         states[i],
                         length_tol,
+                        fixed[i],
                     )
                 })
                 .collect();
@@ -448,6 +486,10 @@ pub fn solve_incremental(
                 tangential_force: [ft[0], ft[1], ft[2]],
                 tangential_magnitude: ft.norm(),
                 friction_bound: t.bound,
+                relative_tangential: {
+                    let g = pair.tangents[0] * t.relative[0] + pair.tangents[1] * t.relative[1];
+                    [g[0], g[1], g[2]]
+                },
             });
         }
         let internal = internal_forces(model, &u);
