@@ -144,3 +144,53 @@ fn errors_are_one_line_with_a_non_zero_exit() {
         String::from_utf8_lossy(&o.stderr)
     );
 }
+
+#[test]
+fn solve_with_contact_writes_increments_contacts_and_a_vtk_series() {
+    let out = tmpdir("contact");
+    let o = run(&[
+        "solve",
+        "fixtures/ok_contact_bars2.toml",
+        "--steps",
+        "4",
+        "--json",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let inc = doc["increments"].as_array().unwrap();
+    assert_eq!(inc.len(), 4);
+    assert_eq!(inc[1]["open"], 1);
+    assert_eq!(inc[3]["open"], 0);
+    assert_eq!(inc[3]["alpha"], 1.0);
+    let c = &doc["contacts"][0];
+    assert_eq!(c["a"]["node"], 4);
+    // Table 5.3 with p = 1000: N = 2.0 N.
+    assert!((c["normal_force"].as_f64().unwrap() - 2.0).abs() < 1e-9);
+    assert_eq!(doc["displacements"].as_object().unwrap().len(), 6);
+    for f in [
+        "increments.csv",
+        "contacts.csv",
+        "solution.pvd",
+        "step_0004.vtu",
+        "contacts_0004.vtu",
+        "displacements.csv",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    let pvd = std::fs::read_to_string(out.join("solution.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 8);
+    let csv = std::fs::read_to_string(out.join("increments.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 5);
+    let o = run(&[
+        "solve",
+        "fixtures/ok_contact_bars2.toml",
+        "--steps",
+        "0",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("at least 1"));
+}
