@@ -168,7 +168,6 @@ fn solve_with_contact(
         ..IncrementalOptions::default()
     };
     let sol = solve_incremental(model, &opts)?;
-    let last = sol.increments.len().saturating_sub(1);
     let pretty = to_pretty(&io::incremental_json(model, &sol))?;
     let final_u = sol.displacements.last().map(|d| &d[..]).unwrap_or(&[]);
     write(
@@ -177,7 +176,7 @@ fn solve_with_contact(
     )?;
     write(&out.join("displacements.json"), &pretty)?;
     write(&out.join("increments.csv"), &io::increments_csv(&sol))?;
-    write(&out.join("contacts.csv"), &io::contacts_csv(&sol, last))?;
+    write(&out.join("contacts.csv"), &io::contacts_csv(&sol))?;
     for (k, rec) in sol.increments.iter().enumerate() {
         write(
             &out.join(io::step_file("step", rec.step)),

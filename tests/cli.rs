@@ -183,6 +183,14 @@ fn solve_with_contact_writes_increments_contacts_and_a_vtk_series() {
     assert_eq!(pvd.matches("<DataSet").count(), 8);
     let csv = std::fs::read_to_string(out.join("increments.csv")).unwrap();
     assert_eq!(csv.lines().count(), 5);
+    let contacts = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
+    assert_eq!(
+        contacts.lines().count(),
+        5,
+        "one contact × four increments + header"
+    );
+    assert!(contacts.lines().nth(1).unwrap().contains(",open,"));
+    assert!(contacts.lines().nth(4).unwrap().contains(",slip,"));
     let o = run(&[
         "solve",
         "fixtures/ok_contact_bars2.toml",

@@ -79,17 +79,19 @@ pub fn increments_csv(sol: &IncrementalSolution) -> String {
     s
 }
 
-/// `contact,fiber_a,fiber_b,x,y,z,state,gap,normal_force,tangential_force,friction_bound` for the
-/// contacts at increment `step` (0-based).
-pub fn contacts_csv(sol: &IncrementalSolution, step: usize) -> String {
+/// `step,alpha,contact,fiber_a,fiber_b,x,y,z,state,gap,normal_force,tangential_force,friction_bound`:
+/// every contact at every increment.
+pub fn contacts_csv(sol: &IncrementalSolution) -> String {
     let mut s = String::from(
-        "contact,fiber_a,fiber_b,x,y,z,state,gap,normal_force,tangential_force,friction_bound\n",
+        "step,alpha,contact,fiber_a,fiber_b,x,y,z,state,gap,normal_force,tangential_force,friction_bound\n",
     );
-    if let Some(records) = sol.contact_results.get(step) {
+    for (inc, records) in sol.increments.iter().zip(&sol.contact_results) {
         for (i, (o, c)) in sol.contacts.origins.iter().zip(records).enumerate() {
             let _ = writeln!(
                 s,
-                "{},{},{},{:e},{:e},{:e},{},{:e},{:e},{:e},{:e}",
+                "{},{},{},{},{},{:e},{:e},{:e},{},{:e},{:e},{:e},{:e}",
+                inc.step,
+                inc.alpha,
                 i + 1,
                 o.fibers[0],
                 o.fibers[1],
