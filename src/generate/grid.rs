@@ -5,6 +5,16 @@ use crate::model::{
     DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec,
 };
 
+/// Steel: E = 210 GPa, ν = 0.3.
+fn steel() -> MaterialSpec {
+    MaterialSpec {
+        name: "steel".into(),
+        young: 2.1e11,
+        poisson: Some(0.3),
+        shear: None,
+    }
+}
+
 /// `k`×`k` straight steel fibers (k along x, k along y, `spacing` apart) joined at their crossings,
 /// each edge split in `sub` elements, clamped along the x = 0 edge, loaded at the far corner.
 pub fn clamped_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDescription {
@@ -51,12 +61,7 @@ pub fn clamped_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDes
         .collect();
     ModelDescription {
         name: Some("grid".into()),
-        materials: vec![MaterialSpec {
-            name: "steel".into(),
-            young: 2.1e11,
-            poisson: Some(0.3),
-            shear: None,
-        }],
+        materials: vec![steel()],
         nodes,
         fibers,
         supports,
@@ -120,12 +125,7 @@ pub fn crossing_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDe
     }
     ModelDescription {
         name: Some("crossing-grid".into()),
-        materials: vec![MaterialSpec {
-            name: "steel".into(),
-            young: 2.1e11,
-            poisson: Some(0.3),
-            shear: None,
-        }],
+        materials: vec![steel()],
         nodes,
         fibers,
         supports,

@@ -35,20 +35,32 @@ fn reactions_json(model: &Model, reactions: &[Reaction]) -> Vec<Value> {
         .collect()
 }
 
+/// The fields every result document starts with: model, units, sizes, displacements keyed by
+/// node id, reactions.
+fn result_document(
+    model: &Model,
+    displacements: &[[f64; 6]],
+    reactions: &[Reaction],
+) -> Map<String, Value> {
+    let mut doc = Map::new();
+    doc.insert("model".into(), json!(model.name));
+    doc.insert("units".into(), json!("SI (m, N, rad)"));
+    doc.insert("nodes".into(), json!(model.nodes.len()));
+    doc.insert("fibers".into(), json!(model.fibers.len()));
+    doc.insert("elements".into(), json!(model.elements().len()));
+    doc.insert(
+        "displacements".into(),
+        Value::Object(displacements_map(model, displacements)),
+    );
+    doc.insert("reactions".into(), json!(reactions_json(model, reactions)));
+    doc
+}
+
 /// One JSON document: `displacements` keyed by node id, `reactions`, and the solver report.
 pub fn solution_json(model: &Model, sol: &StaticSolution) -> Value {
-    let disp = displacements_map(model, &sol.displacements);
-    let reactions = reactions_json(model, &sol.reactions);
-    json!({
-        "model": model.name,
-        "units": "SI (m, N, rad)",
-        "nodes": model.nodes.len(),
-        "fibers": model.fibers.len(),
-        "elements": model.elements().len(),
-        "displacements": disp,
-        "reactions": reactions,
-        "solver": sol.summary,
-    })
+    let mut doc = result_document(model, &sol.displacements, &sol.reactions);
+    doc.insert("solver".into(), json!(sol.summary));
+    Value::Object(doc)
 }
 
 fn side_json(model: &Model, side: ContactSide) -> Value {
@@ -140,16 +152,12 @@ pub fn incremental_json(model: &Model, sol: &IncrementalSolution) -> Value {
         None => Vec::new(),
     };
     let p = sol.contacts.penetration;
-    json!({
-        "model": model.name,
-        "units": "SI (m, N, rad)",
-        "nodes": model.nodes.len(),
-        "fibers": model.fibers.len(),
-        "elements": model.elements().len(),
-        "displacements": displacements_map(model, last),
-        "reactions": reactions_json(model, &sol.reactions),
-        "increments": sol.increments,
-        "contacts": contacts,
-        "initial_penetration": {"count": p.count, "worst_overlap": p.worst_overlap, "adjusted": p.adjusted},
-    })
+    let mut doc = result_document(model, last, &sol.reactions);
+    doc.insert("increments".into(), json!(sol.increments));
+    doc.insert("contacts".into(), json!(contacts));
+    doc.insert(
+        "initial_penetration".into(),
+        json!({"count": p.count, "worst_overlap": p.worst_overlap, "adjusted": p.adjusted}),
+    );
+    Value::Object(doc)
 }

@@ -15,6 +15,16 @@ pub struct Capabilities {
     pub selectable_ordering: bool,
 }
 
+impl Capabilities {
+    /// A direct sparse Cholesky solver with a selectable ordering.
+    pub const DIRECT_SPD: Capabilities = Capabilities {
+        symmetric_only: true,
+        reuses_symbolic: true,
+        iterative: false,
+        selectable_ordering: true,
+    };
+}
+
 /// What `analyze` found.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AnalyzeInfo {

@@ -122,12 +122,7 @@ impl LinearSolver for FaerCholesky {
     }
 
     fn capabilities(&self) -> Capabilities {
-        Capabilities {
-            symmetric_only: true,
-            reuses_symbolic: true,
-            iterative: false,
-            selectable_ordering: true,
-        }
+        Capabilities::DIRECT_SPD
     }
 
     fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError> {
