@@ -10,6 +10,9 @@ pub enum Error {
     /// A model file could not be read or parsed.
     #[error(transparent)]
     Input(#[from] InputError),
+    /// The periodic cell is invalid.
+    #[error("invalid cell: {0}")]
+    Cell(#[from] crate::cell::CellError),
     /// The model is invalid.
     #[error("invalid model: {0}")]
     Model(#[from] ModelError),

@@ -20,11 +20,13 @@
 //! Units are SI throughout (m, N, Pa, rad). DOFs per node: ux, uy, uz, rx, ry, rz.
 
 pub mod assembly;
+pub mod cell;
 pub mod constraints;
 pub mod contact;
 pub mod element;
 mod error;
 pub mod generate;
+pub mod homogenize;
 pub mod io;
 pub mod model;
 pub mod solve;

@@ -40,17 +40,36 @@ impl Pattern {
         dofs: &DofMap,
         extra: &[Vec<usize>],
     ) -> Result<Self, PatternTooLargeError> {
-        let n_nodes = model.nodes.len();
         let elements: Vec<[usize; 2]> = model.elements().iter().map(|e| e.nodes).collect();
-        let blocks = || {
-            elements
-                .iter()
-                .map(|e| &e[..])
-                .chain(extra.iter().map(|b| &b[..]))
-        };
+        let blocks: Vec<&[usize]> = elements
+            .iter()
+            .map(|e| &e[..])
+            .chain(extra.iter().map(|b| &b[..]))
+            .collect();
+        Self::from_blocks(
+            dofs.reduced_indices(),
+            dofs.n_free(),
+            &blocks,
+            elements.len(),
+        )
+    }
+
+    /// The pattern of arbitrary node blocks over a numbering `reduced` (6 entries per node: the
+    /// reduced index of each DOF, `usize::MAX` when it is not an unknown). The first
+    /// `n_elements` blocks are reachable through [`Pattern::element_slots`], the rest through
+    /// [`Pattern::extra_slots`].
+    pub fn from_blocks(
+        reduced: &[usize],
+        n_free: usize,
+        blocks: &[&[usize]],
+        n_elements: usize,
+    ) -> Result<Self, PatternTooLargeError> {
+        let n_nodes = reduced.len() / 6;
+        let red = reduced;
+        let n = n_free;
         let mut adjacency: Vec<Vec<usize>> = (0..n_nodes).map(|i| vec![i]).collect();
-        for b in blocks() {
-            for &p in b {
+        for b in blocks {
+            for &p in b.iter() {
                 adjacency[p].extend_from_slice(b);
             }
         }
@@ -58,8 +77,6 @@ impl Pattern {
             adj.sort_unstable();
             adj.dedup();
         }
-        let red = dofs.reduced_indices();
-        let n = dofs.n_free();
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
         col_ptr.push(0);
@@ -77,11 +94,11 @@ impl Pattern {
         if row_idx.len() >= NO_SLOT as usize {
             return Err(PatternTooLargeError(row_idx.len()));
         }
+        let reduced_of = |g: usize| (red[g] != usize::MAX).then_some(red[g]);
         let mut block_offsets = vec![0];
-        let mut slots = Vec::with_capacity(
-            144 * elements.len() + extra.iter().map(|b| 36 * b.len() * b.len()).sum::<usize>(),
-        );
-        for b in blocks() {
+        let mut slots =
+            Vec::with_capacity(blocks.iter().map(|b| 36 * b.len() * b.len()).sum::<usize>());
+        for b in blocks {
             let m = 6 * b.len();
             let globals: Vec<usize> = b
                 .iter()
@@ -90,10 +107,10 @@ impl Pattern {
             let start = slots.len();
             slots.resize(start + m * m, NO_SLOT);
             for (c, &gc) in globals.iter().enumerate() {
-                let Some(jc) = dofs.reduced(gc) else { continue };
+                let Some(jc) = reduced_of(gc) else { continue };
                 let rows = &row_idx[col_ptr[jc]..col_ptr[jc + 1]];
                 for (r, &gr) in globals.iter().enumerate() {
-                    let Some(ir) = dofs.reduced(gr) else { continue };
+                    let Some(ir) = reduced_of(gr) else { continue };
                     if let Ok(k) = rows.binary_search(&ir) {
                         slots[start + r * m + c] = (col_ptr[jc] + k) as u32;
                     }
@@ -105,7 +122,7 @@ impl Pattern {
             n,
             col_ptr,
             row_idx,
-            n_elements: elements.len(),
+            n_elements,
             block_offsets,
             slots,
         })

@@ -137,5 +137,6 @@ pub fn crossing_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDe
             ..Default::default()
         }),
         contacts: Vec::new(),
+        cell: None,
     }
 }

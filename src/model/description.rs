@@ -32,6 +32,9 @@ pub struct ModelDescription {
     /// Explicit contact pairs.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contacts: Vec<ContactPairSpec>,
+    /// Periodic cell; a model without it is an ordinary structure.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cell: Option<CellSpec>,
 }
 
 /// `[[materials]]`: E with exactly one of ν and G.
@@ -204,4 +207,23 @@ pub enum SideSpec {
         /// Parameter along the segment.
         xi: f64,
     },
+}
+
+/// `[cell]`: the model is a periodic cell of a fabric, periodic in x and y with free top and
+/// bottom faces.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellSpec {
+    /// Periods L_x, L_y (m).
+    pub size: [f64; 2],
+    /// Lower-left corner (x₀, y₀) of the cell (m; default: the smallest node coordinates).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<[f64; 2]>,
+    /// Thickness h used to turn stress resultants into moduli in Pa (m; default: the z extent
+    /// of the fiber surfaces).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+    /// Distance within which boundary nodes are paired (m; default 1e-6 × the smaller period).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
 }

@@ -116,4 +116,7 @@ pub enum ModelError {
         /// What is wrong.
         message: String,
     },
+    /// Invalid `[cell]` settings.
+    #[error("[cell]: {0}")]
+    InvalidCell(String),
 }

@@ -11,7 +11,7 @@ mod section;
 
 pub use contact_settings::{ContactSettings, ExplicitContact};
 pub use description::{
-    ContactPairSpec, ContactSpec, FiberSpec, FrictionSpec, LoadSpec, MaterialSpec,
+    CellSpec, ContactPairSpec, ContactSpec, FiberSpec, FrictionSpec, LoadSpec, MaterialSpec,
     ModelDescription, NodeSpec, PenetrationSpec, SideSpec, SupportSpec,
 };
 pub use dof::{Dof, DofSet};

@@ -2,7 +2,8 @@
 
 use super::contact_settings::{check_pair, check_settings, ContactSettings, ExplicitContact};
 use super::{
-    ContactPairSpec, ContactSpec, Dof, Material, ModelDescription, ModelError, Section, SideSpec,
+    CellSpec, ContactPairSpec, ContactSpec, Dof, Material, ModelDescription, ModelError, Section,
+    SideSpec,
 };
 use crate::contact::ContactSide;
 use std::collections::HashMap;
@@ -79,6 +80,9 @@ pub struct Model {
     pub contact: Option<ContactSettings>,
     /// Explicit contact pairs.
     pub explicit_contacts: Vec<ExplicitContact>,
+    /// The periodic cell, when the model is one (validated geometry; pairing happens in
+    /// [`crate::cell`]).
+    pub cell: Option<CellSpec>,
     elements: Vec<Element>,
     node_index: HashMap<u64, usize>,
     contact_specs: (Option<ContactSpec>, Vec<ContactPairSpec>),
@@ -115,6 +119,32 @@ fn check_material(m: &super::MaterialSpec) -> Result<Material, ModelError> {
         shear,
         poisson: m.poisson,
     })
+}
+
+fn check_cell(c: &super::CellSpec) -> Result<(), ModelError> {
+    let bad = |what: &str, v: f64| {
+        ModelError::InvalidCell(format!("{what} = {v} must be finite and > 0"))
+    };
+    for (k, v) in c.size.iter().enumerate() {
+        if !(v.is_finite() && *v > 0.0) {
+            return Err(bad(["size[0] (L_x)", "size[1] (L_y)"][k], *v));
+        }
+    }
+    if let Some(o) = c.origin {
+        if o.iter().any(|v| !v.is_finite()) {
+            return Err(ModelError::InvalidCell(format!(
+                "origin {o:?} is not finite"
+            )));
+        }
+    }
+    for (what, v) in [("thickness", c.thickness), ("tolerance", c.tolerance)] {
+        if let Some(v) = v {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(what, v));
+            }
+        }
+    }
+    Ok(())
 }
 
 impl Model {
@@ -341,6 +371,9 @@ impl Model {
                         .into(),
             });
         }
+        if let Some(c) = &d.cell {
+            check_cell(c)?;
+        }
         Ok(Model {
             name: d.name.clone(),
             nodes,
@@ -350,6 +383,7 @@ impl Model {
             loads,
             contact,
             explicit_contacts,
+            cell: d.cell.clone(),
             elements,
             node_index,
             contact_specs: (d.contact.clone(), d.contacts.clone()),
@@ -454,6 +488,7 @@ impl Model {
             loads,
             contact: self.contact_specs.0.clone(),
             contacts: self.contact_specs.1.clone(),
+            cell: self.cell.clone(),
         }
     }
 

@@ -1,0 +1,10 @@
+//! The periodic cell: boundary nodes paired across opposite faces, the plate kinematics of the
+//! six macroscopic quantities (ε11, ε22, γ12, κ11, κ22, κ12), and the percolation check.
+
+mod macro_field;
+mod pairing;
+mod percolation;
+
+pub use macro_field::{macro_matrix, MacroStrain, MACRO_NAMES};
+pub use pairing::{pair_boundary_nodes, CellError, CellGeometry, Periodicity};
+pub use percolation::check_percolation;

@@ -1,0 +1,254 @@
+//! Elastic homogenization of periodic grids with fixed junctions against beam-theory closed
+//! forms, independence of where the cell boundary cuts the fibers and of the number of periods,
+//! the 90° rotation swap, ABD symmetry, and bad cells.
+//!
+//! Rectangular grid, x-fibers Ly apart and y-fibers Lx apart, rigidly joined, radius r:
+//! * stretching: A11 = EA/Ly, A22 = EA/Lx, A12 = 0 (the families do not interact);
+//! * in-plane shear γ: each fiber segment between joints (length L) has a chord rotation ±γ/2
+//!   and both ends at the joint rotation θ; its energy is 6EI(θ − ψ)²/L. Minimizing
+//!   6EI[(θ − γ/2)²/Lx + (θ + γ/2)²/Ly] over θ gives U = 6EIγ²/(Lx + Ly), so
+//!   A66 = 2U/(γ² Lx Ly) = 12EI / ((Lx + Ly) Lx Ly);
+//! * bending: D11 = EI/Ly, D22 = EI/Lx, D12 = 0;
+//! * twist κ12 (w = −½κ12 xy): every fiber twists at the rate κ12/2 without bending, so
+//!   D66 = GJ (Lx + Ly) / (4 Lx Ly);
+//! * B = 0 (all fibers in the mid-surface).
+
+use fibercell::homogenize::{homogenize_elastic, Homogenized};
+use fibercell::model::{CellSpec, FiberSpec, MaterialSpec, ModelDescription, NodeSpec};
+use fibercell::solve::SolveOptions;
+use fibercell::{Error, Model};
+use std::f64::consts::PI;
+
+const E: f64 = 1.0e9;
+const NU: f64 = 0.3;
+const R: f64 = 2e-4;
+
+/// `nx` × `ny` periods of the grid, joints at (jx + i Lx, jy + j Ly), `sub` elements per
+/// segment between a joint and a cell face.
+fn grid_cell(
+    lx: f64,
+    ly: f64,
+    jx: f64,
+    jy: f64,
+    nx: usize,
+    ny: usize,
+    sub: usize,
+) -> ModelDescription {
+    let mut d = ModelDescription {
+        materials: vec![MaterialSpec {
+            name: "m".into(),
+            young: E,
+            poisson: Some(NU),
+            shear: None,
+        }],
+        cell: Some(CellSpec {
+            size: [nx as f64 * lx, ny as f64 * ly],
+            origin: Some([0.0, 0.0]),
+            thickness: Some(2.0 * R),
+            tolerance: None,
+        }),
+        ..Default::default()
+    };
+    let mut ids = std::collections::HashMap::new();
+    let mut node = |d: &mut ModelDescription, x: f64, y: f64| -> u64 {
+        let key = ((x * 1e9).round() as i64, (y * 1e9).round() as i64);
+        if let Some(&id) = ids.get(&key) {
+            return id;
+        }
+        let id = d.nodes.len() as u64 + 1;
+        d.nodes.push(NodeSpec { id, x: [x, y, 0.0] });
+        ids.insert(key, id);
+        id
+    };
+    // Stations along a line through the cell: the faces and the joints, each gap split in `sub`.
+    let stations = |len: f64, joint: f64, n: usize| {
+        let mut s = vec![0.0];
+        for k in 0..n {
+            s.push(k as f64 * len + joint);
+        }
+        s.push(n as f64 * len);
+        let mut out = Vec::new();
+        for w in s.windows(2) {
+            for q in 0..sub {
+                out.push(w[0] + (w[1] - w[0]) * q as f64 / sub as f64);
+            }
+        }
+        out.push(n as f64 * len);
+        out
+    };
+    let mut fid = 0;
+    for j in 0..ny {
+        let y = jy + j as f64 * ly;
+        let nodes: Vec<u64> = stations(lx, jx, nx)
+            .into_iter()
+            .map(|x| node(&mut d, x, y))
+            .collect();
+        fid += 1;
+        d.fibers.push(FiberSpec {
+            id: fid,
+            nodes,
+            radius: R,
+            material: "m".into(),
+        });
+    }
+    for i in 0..nx {
+        let x = jx + i as f64 * lx;
+        let nodes: Vec<u64> = stations(ly, jy, ny)
+            .into_iter()
+            .map(|y| node(&mut d, x, y))
+            .collect();
+        fid += 1;
+        d.fibers.push(FiberSpec {
+            id: fid,
+            nodes,
+            radius: R,
+            material: "m".into(),
+        });
+    }
+    d
+}
+
+fn homogenize(d: &ModelDescription) -> Homogenized {
+    homogenize_elastic(
+        &Model::from_description(d).unwrap(),
+        &SolveOptions::default(),
+    )
+    .unwrap()
+}
+
+fn closed_form(lx: f64, ly: f64) -> [[f64; 6]; 6] {
+    let (a, i, j) = (PI * R * R, PI * R.powi(4) / 4.0, PI * R.powi(4) / 2.0);
+    let g = E / (2.0 * (1.0 + NU));
+    let mut abd = [[0.0; 6]; 6];
+    abd[0][0] = E * a / ly;
+    abd[1][1] = E * a / lx;
+    abd[2][2] = 12.0 * E * i / ((lx + ly) * lx * ly);
+    abd[3][3] = E * i / ly;
+    abd[4][4] = E * i / lx;
+    abd[5][5] = g * j * (lx + ly) / (4.0 * lx * ly);
+    abd
+}
+
+fn assert_abd(got: &[[f64; 6]; 6], want: &[[f64; 6]; 6], tol: f64) {
+    // Each block against its own scale (A ~ EA/L, D ~ EI/L: orders of magnitude apart).
+    for r in 0..6 {
+        for c in 0..6 {
+            let scale = (want[r][r].abs() * want[c][c].abs()).sqrt();
+            assert!(
+                (got[r][c] - want[r][c]).abs() <= tol * scale,
+                "ABD[{r}][{c}] = {:e}, want {:e}",
+                got[r][c],
+                want[r][c]
+            );
+        }
+    }
+}
+
+#[test]
+fn square_and_rectangular_grids_match_beam_theory() {
+    for (lx, ly) in [(5e-3, 5e-3), (4e-3, 7e-3)] {
+        let h = homogenize(&grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 2));
+        assert_abd(&h.abd, &closed_form(lx, ly), 1e-9);
+        assert!(h.asymmetry <= 1e-10, "asymmetry {}", h.asymmetry);
+        // Orthotropic constants of §5.1.2 (A12 = 0: E1 = A11, E2 = A22, ν = 0).
+        assert!((h.orthotropic.e1 - h.abd[0][0]).abs() <= 1e-12 * h.abd[0][0]);
+        assert!(h.orthotropic.nu12.abs() <= 1e-9);
+        assert!(
+            (h.orthotropic.e1_pa - h.abd[0][0] / (2.0 * R)).abs() <= 1e-9 * h.orthotropic.e1_pa
+        );
+    }
+}
+
+#[test]
+fn result_does_not_depend_on_where_the_boundary_cuts_the_fibers() {
+    let (lx, ly) = (4e-3, 7e-3);
+    let centred = homogenize(&grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 3));
+    let shifted = homogenize(&grid_cell(lx, ly, 0.3 * lx, 0.85 * ly, 1, 1, 3));
+    assert_abd(&shifted.abd, &centred.abd, 1e-9);
+}
+
+#[test]
+fn result_does_not_depend_on_the_number_of_periods() {
+    let (lx, ly) = (4e-3, 7e-3);
+    let one = homogenize(&grid_cell(lx, ly, 0.4 * lx, 0.6 * ly, 1, 1, 2));
+    let six = homogenize(&grid_cell(lx, ly, 0.4 * lx, 0.6 * ly, 2, 3, 2));
+    assert_abd(&six.abd, &one.abd, 1e-9);
+    assert!(six.paired_nodes > one.paired_nodes);
+}
+
+#[test]
+fn rotating_the_geometry_by_90_degrees_swaps_the_directions() {
+    let (lx, ly) = (4e-3, 7e-3);
+    let h = homogenize(&grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 2));
+    // (x, y) → (y', x') with y' = Lx... : the rotated cell is the grid with the periods swapped,
+    // built by rotating every node by 90° about the origin and shifting back into the box.
+    let mut d = grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 2);
+    for n in &mut d.nodes {
+        n.x = [ly - n.x[1], n.x[0], n.x[2]];
+    }
+    d.cell.as_mut().unwrap().size = [ly, lx];
+    let r = homogenize(&d);
+    for (a, b) in [(0, 1), (3, 4)] {
+        assert!((r.abd[a][a] - h.abd[b][b]).abs() <= 1e-9 * h.abd[b][b]);
+        assert!((r.abd[b][b] - h.abd[a][a]).abs() <= 1e-9 * h.abd[a][a]);
+    }
+    assert!((r.abd[2][2] - h.abd[2][2]).abs() <= 1e-9 * h.abd[2][2]);
+    assert!((r.abd[5][5] - h.abd[5][5]).abs() <= 1e-9 * h.abd[5][5]);
+}
+
+#[test]
+fn bad_cells_are_reported() {
+    let (lx, ly) = (4e-3, 7e-3);
+    // A fiber end without a partner: drop the last node of the first x-fiber.
+    let mut d = grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 1);
+    let removed = d.fibers[0].nodes.pop().unwrap();
+    d.nodes.retain(|n| n.id != removed);
+    let e = homogenize_elastic(
+        &Model::from_description(&d).unwrap(),
+        &SolveOptions::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, Error::Cell(fibercell::cell::CellError::Unpaired { .. })),
+        "{e}"
+    );
+    assert!(e.to_string().contains("no partner"), "{e}");
+    // Only x-fibers: no load path in y.
+    let mut d = grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 2);
+    let y_fiber = d.fibers.pop().unwrap();
+    let keep: std::collections::HashSet<u64> =
+        d.fibers.iter().flat_map(|f| f.nodes.clone()).collect();
+    d.nodes
+        .retain(|n| keep.contains(&n.id) || !y_fiber.nodes.contains(&n.id));
+    let e = homogenize_elastic(
+        &Model::from_description(&d).unwrap(),
+        &SolveOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("do not percolate in y"), "{e}");
+    // A node outside the box.
+    let mut d = grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 2);
+    d.nodes[3].x[0] += lx;
+    let e = homogenize_elastic(
+        &Model::from_description(&d).unwrap(),
+        &SolveOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("outside the cell"), "{e}");
+    // Invalid sizes.
+    let mut d = grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 2);
+    d.cell.as_mut().unwrap().size[1] = f64::NAN;
+    assert!(Model::from_description(&d)
+        .unwrap_err()
+        .to_string()
+        .contains("size[1]"));
+    // A model without [cell].
+    let mut d = grid_cell(lx, ly, 0.5 * lx, 0.5 * ly, 1, 1, 2);
+    d.cell = None;
+    let e = homogenize_elastic(
+        &Model::from_description(&d).unwrap(),
+        &SolveOptions::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("no [cell]"), "{e}");
+}
