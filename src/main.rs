@@ -46,6 +46,21 @@ enum Command {
         #[arg(short, long, default_value = "fibercell-results")]
         output: PathBuf,
     },
+    /// Effective stiffness of a periodic cell: ABD per unit area, the thesis's moduli and the
+    /// orthotropic constants.
+    Homogenize {
+        /// Model file with a [cell] section.
+        model: PathBuf,
+        /// Linear solver backend.
+        #[arg(long, default_value = "faer-cholesky", value_parser = parse_solver)]
+        solver: SolverKind,
+        /// Print one JSON document instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Also write homogenized.json and the six cell-problem solutions (case_*.vtu) here.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Write the reduced stiffness matrix in Matrix Market form (symmetric, lower triangle).
     ExportMatrix {
         /// Model file.
@@ -229,6 +244,72 @@ fn solve_with_contact(
     Ok(())
 }
 
+fn homogenize(
+    model_path: &Path,
+    solver: SolverKind,
+    json: bool,
+    out: Option<&Path>,
+) -> Result<(), Error> {
+    let model = io::load_model(model_path)?;
+    let options = SolveOptions {
+        solver,
+        ..SolveOptions::default()
+    };
+    let h = fibercell::homogenize::homogenize_elastic(&model, &options)?;
+    let pretty = to_pretty(&serde_json::to_value(&h).map_err(|e| Error::Output {
+        path: "json".into(),
+        message: e.to_string(),
+    })?)?;
+    if let Some(out) = out {
+        std::fs::create_dir_all(out).map_err(|e| Error::Output {
+            path: out.display().to_string(),
+            message: e.to_string(),
+        })?;
+        write(&out.join("homogenized.json"), &pretty)?;
+        for (k, case) in h.cases.iter().enumerate() {
+            let name = format!("case_{}.vtu", fibercell::cell::MACRO_NAMES[k]);
+            write(&out.join(name), &io::deformed_vtu(&model, case))?;
+        }
+    }
+    if json {
+        println!("{pretty}");
+        return Ok(());
+    }
+    println!(
+        "{}: cell {:.4e} m² ({} free DOFs, {} paired boundary nodes), thickness {:.4e} m, backend {}",
+        model_path.display(),
+        h.area,
+        h.free_dofs,
+        h.paired_nodes,
+        h.thickness,
+        h.backend
+    );
+    println!(
+        "ABD per unit area (rows/columns e11 e22 g12 k11 k22 k12; A in N/m, B in N, D in N·m):"
+    );
+    for row in &h.abd {
+        println!(
+            "  {}",
+            row.iter()
+                .map(|v| format!("{v:>13.5e}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+    }
+    println!("asymmetry max|ABD − ABDᵀ|/max|ABD| = {:.2e}", h.asymmetry);
+    let m = &h.moduli;
+    println!(
+        "moduli: a11_11 {:.5e}  a22_22 {:.5e}  a12_12 {:.5e}  a22_11 {:.5e} N/m;  c1111 {:.5e}  c1122 {:.5e}  c2222 {:.5e} N·m",
+        m.a11_11, m.a22_22, m.a12_12, m.a22_11, m.c1111, m.c1122, m.c2222
+    );
+    let o = &h.orthotropic;
+    println!(
+        "orthotropic: E1 {:.5e} N/m ({:.5e} Pa)  E2 {:.5e} N/m ({:.5e} Pa)  G12 {:.5e} N/m ({:.5e} Pa)  nu12 {:.5}  nu21 {:.5}",
+        o.e1, o.e1_pa, o.e2, o.e2_pa, o.g12, o.g12_pa, o.nu12, o.nu21
+    );
+    Ok(())
+}
+
 fn export_matrix(model_path: &Path, out: &Path) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
     let sys = fibercell::solve::ReducedSystem::assemble(&model, Default::default())?;
@@ -265,6 +346,12 @@ fn main() -> ExitCode {
             json,
             &output,
         ),
+        Command::Homogenize {
+            model,
+            solver,
+            json,
+            output,
+        } => homogenize(&model, solver, json, output.as_deref()),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
     };
     match r {

@@ -202,3 +202,29 @@ fn solve_with_contact_writes_increments_contacts_and_a_vtk_series() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("at least 1"));
 }
+
+#[test]
+fn homogenize_prints_abd_and_writes_the_cell_problems() {
+    let out = tmpdir("homog");
+    let o = run(&[
+        "homogenize",
+        "fixtures/ok_cell_grid.toml",
+        "--json",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // A11 = EA/Ly with E = 1 GPa, r = 0.2 mm, Ly = 7 mm.
+    let a11 = doc["abd"][0][0].as_f64().unwrap();
+    let want = 1e9 * std::f64::consts::PI * 4e-8 / 7e-3;
+    assert!((a11 - want).abs() <= 1e-9 * want, "{a11} vs {want}");
+    assert!(doc["asymmetry"].as_f64().unwrap() < 1e-10);
+    assert_eq!(doc["orthotropic"]["e1"], doc["abd"][0][0]);
+    for k in ["e11", "e22", "g12", "k11", "k22", "k12"] {
+        assert!(out.join(format!("case_{k}.vtu")).exists());
+    }
+    let o = run(&["homogenize", "fixtures/ok_frame3d.toml"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no [cell] section"));
+}
