@@ -50,7 +50,7 @@ fn fibers(lines: &[([f64; 3], [f64; 3], f64)], sub: usize) -> ModelDescription {
     d
 }
 
-fn block(pair: &ContactPair, m: &nalgebra::SMatrix<f64, 24, 24>) -> DMatrix<f64> {
+fn block(pair: &ContactPair, m: &fibercell::contact::BlockMatrix) -> DMatrix<f64> {
     let n = pair.size();
     DMatrix::from_fn(n, n, |i, j| m[(i, j)])
 }

@@ -1,6 +1,8 @@
 //! Supports and loads: the right-hand side of the reduced system (nodal loads minus the
 //! coupling to prescribed DOFs) and the reactions at prescribed DOFs.
 
+mod discretization;
 mod loads;
 
 pub use loads::{internal_forces, reactions, reduced_rhs, Reaction};
+pub use discretization::Discretization;

@@ -7,8 +7,9 @@ use crate::element::{hermite, linear, local_frame};
 use crate::model::Model;
 use nalgebra::{Matrix3, SMatrix};
 
-/// Up to four nodes × six DOFs.
-pub type JumpMatrix = SMatrix<f64, 3, 24>;
+/// Up to five generalized nodes × six DOFs (four nodes of two elements, plus the driver node of a
+/// periodic cell).
+pub type JumpMatrix = SMatrix<f64, 3, 30>;
 
 /// One side of a contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,7 +30,7 @@ pub enum ContactSide {
 pub struct Jump {
     /// Distinct node indices of the block.
     pub nodes: Vec<usize>,
-    /// The 3 × 6k jump operator, padded to 24 columns.
+    /// The 3 × 6k jump operator, padded to 30 columns.
     pub b: JumpMatrix,
 }
 

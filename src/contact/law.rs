@@ -16,10 +16,10 @@
 use super::kinematics::Jump;
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
-/// A 24 × 24 contact block (the top-left 6k × 6k part is used).
-pub type BlockMatrix = SMatrix<f64, 24, 24>;
-/// A 24-vector of block loads.
-pub type BlockVector = SVector<f64, 24>;
+/// A 30 × 30 contact block (the top-left 6k × 6k part is used).
+pub type BlockMatrix = SMatrix<f64, 30, 30>;
+/// A 30-vector of block loads.
+pub type BlockVector = SVector<f64, 30>;
 
 /// The friction law.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
