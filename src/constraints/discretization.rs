@@ -66,7 +66,13 @@ impl Discretization {
         Self::number(n, n + 1, fixed, prescribed, maps)
     }
 
-    fn number(n_nodes: usize, n_gnodes: usize, fixed: Vec<bool>, prescribed: Vec<f64>, maps: Vec<Option<Vec<(usize, Matrix6)>>>) -> Self {
+    fn number(
+        n_nodes: usize,
+        n_gnodes: usize,
+        fixed: Vec<bool>,
+        prescribed: Vec<f64>,
+        maps: Vec<Option<Vec<(usize, Matrix6)>>>,
+    ) -> Self {
         let mut reduced = vec![usize::MAX; 6 * n_gnodes];
         let mut free = Vec::new();
         for g in 0..6 * n_gnodes {

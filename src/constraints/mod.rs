@@ -4,5 +4,5 @@
 mod discretization;
 mod loads;
 
-pub use loads::{internal_forces, reactions, reduced_rhs, Reaction};
 pub use discretization::Discretization;
+pub use loads::{internal_forces, reactions, reduced_rhs, Reaction};

@@ -10,15 +10,14 @@
 //! Coulomb-sliding contact are nonsymmetric and go to LU, all others to the chosen symmetric
 //! backend.
 
-use super::static_solve::locate;
 use super::{check_supported_with, make_solver, SolveOptions, SolverKind};
-use crate::assembly::{Assembler, DofMap, Pattern};
-use crate::constraints::{internal_forces, reduced_rhs, Reaction};
+use crate::assembly::{element_stiffness, Assembler, DofMap, Pattern, NO_SLOT};
+use crate::constraints::{internal_forces, Discretization, Reaction};
 use crate::contact::{BlockVector, ContactPair, ContactSet, ContactSide, ContactState, Friction};
 use crate::model::Model;
 use crate::Error;
 use fibercell_solver::{solve_checked, LinearSolver, SolverError};
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use serde::Serialize;
 
 /// Options of [`solve_incremental`].
@@ -68,6 +67,10 @@ pub struct IncrementRecord {
     pub applied_load: [f64; 6],
     /// Support reactions summed per DOF.
     pub reaction: [f64; 6],
+    /// For a periodic cell: the reactions of the six macroscopic drivers (stress resultants
+    /// times the cell area).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub macro_reaction: Option<[f64; 6]>,
     /// Backend of the last solve.
     pub backend: String,
     /// Backward error of the last solve.
@@ -231,6 +234,137 @@ pub fn solve_incremental(
     model: &Model,
     opts: &IncrementalOptions,
 ) -> Result<IncrementalSolution, Error> {
+    let set = ContactSet::build(model)?;
+    run_incremental(model, &Discretization::supported(model), set, opts)
+}
+
+/// The elastic part on a discretization: element blocks on generalized nodes.
+struct Elastic {
+    /// Generalized nodes and T of every element (None: the element's own nodes, T = I).
+    maps: Vec<Option<(Vec<usize>, DMatrix<f64>)>>,
+}
+
+impl Elastic {
+    fn new(model: &Model, disc: &Discretization) -> Self {
+        let identity = disc.is_identity();
+        Elastic {
+            maps: model
+                .elements()
+                .iter()
+                .map(|e| (!identity).then(|| disc.block(&e.nodes)))
+                .collect(),
+        }
+    }
+
+    fn gnodes(&self, model: &Model, e: usize) -> Vec<usize> {
+        match &self.maps[e] {
+            Some((g, _)) => g.clone(),
+            None => model.elements()[e].nodes.to_vec(),
+        }
+    }
+
+    /// Tᵀ K T of element e on its generalized nodes.
+    fn matrix(&self, model: &Model, e: usize) -> DMatrix<f64> {
+        let k = element_stiffness(model, e);
+        let k = DMatrix::from_fn(12, 12, |r, c| k[(r, c)]);
+        match &self.maps[e] {
+            Some((_, t)) => t.transpose() * k * t,
+            None => k,
+        }
+    }
+
+    fn fill(
+        &self,
+        model: &Model,
+        pattern: &Pattern,
+        values: &mut [f64],
+        mode: crate::assembly::FillMode,
+    ) -> Result<(), Error> {
+        if self.maps.iter().all(|m| m.is_none()) {
+            Assembler::new(model).fill(model, pattern, values, mode)?;
+            return Ok(());
+        }
+        values.iter_mut().for_each(|v| *v = 0.0);
+        for e in 0..self.maps.len() {
+            let k = self.matrix(model, e);
+            let m = k.nrows();
+            let slots = pattern.element_slots(e);
+            for r in 0..m {
+                for c in 0..m {
+                    let s = slots[r * m + c];
+                    if s != NO_SLOT {
+                        values[s as usize] += k[(r, c)];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// F_f − K_fc u_c at α = 1, with the nodal loads mapped onto generalized nodes.
+    fn rhs(&self, model: &Model, disc: &Discretization) -> Vec<f64> {
+        let mut rhs = vec![0.0; disc.n_free()];
+        for l in &model.loads {
+            let (gnodes, t) = disc.block(&[l.node]);
+            for c in 0..t.ncols() {
+                if let Some(r) = disc.reduced(6 * gnodes[c / 6] + c % 6) {
+                    rhs[r] += t[(l.dof.index(), c)] * l.value;
+                }
+            }
+        }
+        for e in 0..self.maps.len() {
+            let gnodes = self.gnodes(model, e);
+            let prescribed = |c: usize| {
+                let g = 6 * gnodes[c / 6] + c % 6;
+                disc.reduced(g)
+                    .is_none()
+                    .then(|| disc.prescribed_value(g))
+                    .filter(|v| *v != 0.0)
+            };
+            if !(0..6 * gnodes.len()).any(|c| prescribed(c).is_some()) {
+                continue;
+            }
+            let k = self.matrix(model, e);
+            for r in 0..k.nrows() {
+                if let Some(i) = disc.reduced(6 * gnodes[r / 6] + r % 6) {
+                    for c in 0..k.ncols() {
+                        if let Some(v) = prescribed(c) {
+                            rhs[i] -= k[(r, c)] * v;
+                        }
+                    }
+                }
+            }
+        }
+        rhs
+    }
+
+    /// Generalized internal forces K q for the full generalized vector q.
+    fn internal(&self, model: &Model, disc: &Discretization, q: &[f64]) -> Vec<f64> {
+        if self.maps.iter().all(|m| m.is_none()) {
+            return internal_forces(model, &q[..6 * model.nodes.len()]);
+        }
+        let mut out = vec![0.0; q.len()];
+        for e in 0..self.maps.len() {
+            let gnodes = self.gnodes(model, e);
+            let k = self.matrix(model, e);
+            let qe = DVector::from_fn(6 * gnodes.len(), |c, _| q[6 * gnodes[c / 6] + c % 6]);
+            let f = k * qe;
+            for (r, v) in f.iter().enumerate() {
+                out[6 * gnodes[r / 6] + r % 6] += v;
+            }
+        }
+        let _ = disc;
+        out
+    }
+}
+
+/// The incremental analysis on any discretization (supported structure or periodic cell).
+pub(crate) fn run_incremental(
+    model: &Model,
+    disc: &Discretization,
+    set: ContactSet,
+    opts: &IncrementalOptions,
+) -> Result<IncrementalSolution, Error> {
     if opts.steps == 0 {
         return Err(Error::InvalidOption(
             "the number of increments must be at least 1".into(),
@@ -241,7 +375,6 @@ pub fn solve_incremental(
             "max_state_iterations must be at least 1".into(),
         ));
     }
-    let set = ContactSet::build(model)?;
     let friction = model
         .contact
         .as_ref()
@@ -252,8 +385,10 @@ pub fn solve_incremental(
             if let Some(c) = frictionless.contact.as_mut() {
                 c.friction = Friction::None;
             }
-            let pre = solve_incremental(
+            let pre = run_incremental(
                 &frictionless,
+                disc,
+                set.clone(),
                 &IncrementalOptions {
                     fixed_slip_direction: false,
                     ..opts.clone()
@@ -272,12 +407,37 @@ pub fn solve_incremental(
         } else {
             vec![None; set.pairs.len()]
         };
-    let dofs = DofMap::new(model);
-    let pattern = Pattern::with_blocks(model, &dofs, &set.blocks())?;
+    // Contact jumps on generalized nodes: B T.
+    let mut pairs = set.pairs.clone();
+    if !disc.is_identity() {
+        for p in &mut pairs {
+            let k = p.jump.nodes.len();
+            let (gnodes, t) = disc.block(&p.jump.nodes);
+            let b = DMatrix::from_fn(3, 6 * k, |r, c| p.jump.b[(r, c)]) * t;
+            let mut padded = crate::contact::JumpMatrix::zeros();
+            padded.view_mut((0, 0), (3, b.ncols())).copy_from(&b);
+            p.jump = crate::contact::Jump {
+                nodes: gnodes,
+                b: padded,
+            };
+        }
+    }
+    let elastic = Elastic::new(model, disc);
+    let mut blocks: Vec<Vec<usize>> = (0..model.elements().len())
+        .map(|e| elastic.gnodes(model, e))
+        .collect();
+    blocks.extend(pairs.iter().map(|p| p.jump.nodes.clone()));
+    let block_refs: Vec<&[usize]> = blocks.iter().map(|b| &b[..]).collect();
+    let pattern = Pattern::from_blocks(
+        disc.reduced_indices(),
+        disc.n_free(),
+        &block_refs,
+        model.elements().len(),
+    )?;
     let mut k_elastic = vec![0.0; pattern.nnz()];
-    Assembler::new(model).fill(model, &pattern, &mut k_elastic, opts.solve.fill)?;
-    let rhs_full = reduced_rhs(model, &dofs);
-    let n_free = dofs.n_free();
+    elastic.fill(model, &pattern, &mut k_elastic, opts.solve.fill)?;
+    let rhs_full = elastic.rhs(model, disc);
+    let n_free = disc.n_free();
     let mut applied_full = [0.0; 6];
     for l in &model.loads {
         applied_full[l.dof.index()] += l.value;
@@ -290,6 +450,20 @@ pub fn solve_incremental(
         opts.solve.max_backward_error
     } else {
         1e-10
+    };
+    let locate = |e: SolverError| match e {
+        SolverError::NotPositiveDefinite { column, pivot }
+            if column < n_free && disc.node_dof(column).0 < model.nodes.len() =>
+        {
+            let (node, dof) = disc.node_dof(column);
+            Error::Singular {
+                node: model.nodes[node].id,
+                dof,
+                fibers: model.fibers_at_node(node),
+                pivot,
+            }
+        }
+        other => Error::Solver(other),
     };
 
     // Contact states: closed pairs start in stick (thesis step 1), others open.
@@ -304,15 +478,15 @@ pub fn solve_incremental(
             ContactState::Open
         }
     };
-    let mut states: Vec<ContactState> = set.pairs.iter().map(initial).collect();
-    let mut directions: Vec<Vector2<f64>> = vec![Vector2::zeros(); set.pairs.len()];
-    let mut slips: Vec<Vector2<f64>> = vec![Vector2::zeros(); set.pairs.len()];
+    let mut states: Vec<ContactState> = pairs.iter().map(initial).collect();
+    let mut directions: Vec<Vector2<f64>> = vec![Vector2::zeros(); pairs.len()];
+    let mut slips: Vec<Vector2<f64>> = vec![Vector2::zeros(); pairs.len()];
     // What the current factorization was built from (None: nothing factorized yet).
     let mut factorized: Option<(bool, Vec<ContactState>, Vec<Vector2<f64>>)> = None;
 
     let length_tol = 1e-12 * model_size(model);
     let mut values = k_elastic.clone();
-    let mut u = vec![0.0; dofs.n_global()];
+    let mut q = vec![0.0; 6 * disc.n_gnodes()];
     let mut out = IncrementalSolution {
         contacts: set.clone(),
         increments: Vec::with_capacity(opts.steps),
@@ -320,19 +494,18 @@ pub fn solve_incremental(
         displacements: Vec::with_capacity(opts.steps),
         reactions: Vec::new(),
     };
-    let gather = |u: &[f64], nodes: &[usize]| {
-        let mut q = BlockVector::zeros();
+    let gather = |q: &[f64], nodes: &[usize]| {
+        let mut v = BlockVector::zeros();
         for (k, &n) in nodes.iter().enumerate() {
             for d in 0..6 {
-                q[6 * k + d] = u[6 * n + d];
+                v[6 * k + d] = q[6 * n + d];
             }
         }
-        q
+        v
     };
 
     for step in 1..=opts.steps {
         let alpha = step as f64 / opts.steps as f64;
-        let prescribed = |g: usize| alpha * dofs.prescribed_value(g);
         let mut factorizations = 0;
         let mut converged = None;
         for iteration in 1..=opts.max_state_iterations {
@@ -341,11 +514,11 @@ pub fn solve_incremental(
             let mut rhs: Vec<f64> = rhs_full.iter().map(|v| alpha * v).collect();
             let mut closed: Vec<&[usize]> = Vec::new();
             let mut nonsymmetric = false;
-            for (i, pair) in set.pairs.iter().enumerate() {
+            for (i, pair) in pairs.iter().enumerate() {
                 if states[i] == ContactState::Open {
                     continue;
                 }
-                closed.push(&pair.jump.nodes);
+                closed.push(&set.pairs[i].jump.nodes);
                 let (mut k, mut f) = pair.normal();
                 let (kt, ft) = match states[i] {
                     ContactState::Stick => pair.stick(&slips[i]),
@@ -358,22 +531,25 @@ pub fn solve_incremental(
                 f += ft;
                 let m = pair.size();
                 let slots = pattern.extra_slots(i);
-                let globals = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
+                let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
                 for r in 0..m {
-                    let gr = globals(r);
-                    let Some(ir) = dofs.reduced(gr) else { continue };
+                    let Some(ir) = disc.reduced(gdof(r)) else {
+                        continue;
+                    };
                     rhs[ir] += f[r];
                     for c in 0..m {
                         let s = slots[r * m + c];
-                        if s != crate::assembly::NO_SLOT {
+                        if s != NO_SLOT {
                             values[s as usize] += k[(r, c)];
-                        } else if dofs.reduced(globals(c)).is_none() {
-                            rhs[ir] -= k[(r, c)] * prescribed(globals(c));
+                        } else if disc.reduced(gdof(c)).is_none() {
+                            rhs[ir] -= k[(r, c)] * alpha * disc.prescribed_value(gdof(c));
                         }
                     }
                 }
             }
-            check_supported_with(model, &closed)?;
+            if disc.is_identity() {
+                check_supported_with(model, &closed)?;
+            }
             let a = pattern.matrix(&values)?;
             let (slot, kind) = if nonsymmetric {
                 (&mut backends.general, SolverKind::FaerLu)
@@ -381,8 +557,8 @@ pub fn solve_incremental(
                 (&mut backends.symmetric, opts.solve.solver)
             };
             if slot.is_none() {
-                let mut s = make_solver(kind, &opts.solve.ordering, dofs.node_block_starts())?;
-                s.analyze(a).map_err(|e| locate(e, model, &dofs))?;
+                let mut s = make_solver(kind, &opts.solve.ordering, disc.node_block_starts())?;
+                s.analyze(a).map_err(locate)?;
                 *slot = Some(s);
             }
             let solver = slot
@@ -390,15 +566,14 @@ pub fn solve_incremental(
                 .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "analyze")))?;
             let key = (nonsymmetric, states.clone(), directions.clone());
             if factorized.as_ref() != Some(&key) {
-                solver.factorize(a).map_err(|e| locate(e, model, &dofs))?;
+                solver.factorize(a).map_err(locate)?;
                 factorizations += 1;
                 factorized = Some(key);
             }
             let (x, report) = if n_free == 0 {
                 (Vec::new(), None)
             } else {
-                let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1)
-                    .map_err(|e| locate(e, model, &dofs))?;
+                let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1).map_err(locate)?;
                 (x, Some(r))
             };
             let bwd = report.as_ref().map_or(0.0, |r| r.backward_error);
@@ -410,22 +585,16 @@ pub fn solve_incremental(
                     ),
                 }));
             }
-            for (g, ug) in u.iter_mut().enumerate() {
-                *ug = match dofs.reduced(g) {
-                    Some(r) => x[r],
-                    None => prescribed(g),
-                };
-            }
+            q = disc.generalized(&x, alpha);
             // Return mapping of every contact.
-            let trials: Vec<Trial> = set
-                .pairs
+            let trials: Vec<Trial> = pairs
                 .iter()
                 .enumerate()
                 .map(|(i, p)| {
                     classify(
                         p,
                         friction,
-                        &gather(&u, &p.jump.nodes),
+                        &gather(&q, &p.jump.nodes),
                         &slips[i],
                         states[i],
                         length_tol,
@@ -433,7 +602,7 @@ pub fn solve_incremental(
                     )
                 })
                 .collect();
-            let changed: Vec<usize> = (0..set.pairs.len())
+            let changed: Vec<usize> = (0..pairs.len())
                 .filter(|&i| {
                     let t = &trials[i];
                     t.state != states[i]
@@ -462,9 +631,9 @@ pub fn solve_incremental(
             return Err(Error::InvalidOption("no state iteration ran".into()));
         };
         // Commit the slip history and record the increment.
-        let mut records = Vec::with_capacity(set.pairs.len());
-        let mut contact_forces = vec![0.0; dofs.n_global()];
-        for (i, (pair, t)) in set.pairs.iter().zip(&trials).enumerate() {
+        let mut records = Vec::with_capacity(pairs.len());
+        let mut forces = elastic.internal(model, disc, &q);
+        for (i, (pair, t)) in pairs.iter().zip(&trials).enumerate() {
             match t.state {
                 ContactState::Open => slips[i] = t.relative,
                 ContactState::Slip => slips[i] = t.relative - t.tangential / pair.penalty_tangent,
@@ -476,7 +645,7 @@ pub fn solve_incremental(
             let fq = pair.jump.b.transpose() * force;
             for (k, &n) in pair.jump.nodes.iter().enumerate() {
                 for d in 0..6 {
-                    contact_forces[6 * n + d] += fq[6 * k + d];
+                    forces[6 * n + d] += fq[6 * k + d];
                 }
             }
             records.push(ContactRecord {
@@ -492,7 +661,6 @@ pub fn solve_incremental(
                 },
             });
         }
-        let internal = internal_forces(model, &u);
         let mut reaction = [0.0; 6];
         let mut reactions = Vec::with_capacity(model.supports.len());
         for s in &model.supports {
@@ -503,7 +671,7 @@ pub fn solve_incremental(
                 .filter(|l| l.node == s.node && l.dof == s.dof)
                 .map(|l| alpha * l.value)
                 .sum();
-            let value = internal[g] + contact_forces[g] - load;
+            let value = forces[g] - load;
             reaction[s.dof.index()] += value;
             reactions.push(Reaction {
                 node: s.node,
@@ -511,6 +679,9 @@ pub fn solve_incremental(
                 value,
             });
         }
+        let macro_reaction = disc
+            .driver()
+            .map(|d| [0, 1, 2, 3, 4, 5].map(|k| forces[6 * d + k]));
         let count = |s: ContactState| records.iter().filter(|r| r.state == s).count();
         let (backend, bwd) = report.unwrap_or(("none", 0.0));
         out.increments.push(IncrementRecord {
@@ -523,15 +694,12 @@ pub fn solve_incremental(
             slip: count(ContactState::Slip),
             applied_load: applied_full.map(|v| alpha * v),
             reaction,
+            macro_reaction,
             backend: backend.to_string(),
             backward_error: bwd,
         });
         out.contact_results.push(records);
-        out.displacements.push(
-            u.chunks(6)
-                .map(|c| [c[0], c[1], c[2], c[3], c[4], c[5]])
-                .collect(),
-        );
+        out.displacements.push(disc.physical(&q));
         out.reactions = reactions;
     }
     Ok(out)
