@@ -258,3 +258,17 @@ pub fn pair_boundary_nodes(model: &Model) -> Result<Periodicity, CellError> {
         .collect();
     Ok(Periodicity { geometry, master })
 }
+
+/// The independent node nearest the cell centre: its translations are fixed to remove the rigid
+/// translations, the only rigid motions periodicity leaves.
+pub fn anchor_node(model: &Model, p: &Periodicity) -> Result<usize, CellError> {
+    let g = &p.geometry;
+    let centre = [g.origin[0] + 0.5 * g.size[0], g.origin[1] + 0.5 * g.size[1]];
+    let d = |i: usize| {
+        (model.nodes[i].x[0] - centre[0]).powi(2) + (model.nodes[i].x[1] - centre[1]).powi(2)
+    };
+    (0..model.nodes.len())
+        .filter(|&i| p.master[i].is_none())
+        .min_by(|&a, &b| d(a).total_cmp(&d(b)))
+        .ok_or(CellError::NotACell)
+}

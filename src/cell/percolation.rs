@@ -16,16 +16,25 @@ fn find(parent: &mut [usize], offset: &mut [[i32; 2]], i: usize) -> (usize, [i32
 }
 
 /// Checks that every fiber is connected to the others and that chains of fibers cross the cell
-/// in x and in y.
-pub fn check_percolation(model: &Model, p: &Periodicity) -> Result<(), CellError> {
+/// in x and in y. `links` are extra node pairs joined inside the cell (the closed contacts).
+pub fn check_percolation(
+    model: &Model,
+    p: &Periodicity,
+    links: &[[usize; 2]],
+) -> Result<(), CellError> {
     let n = model.nodes.len();
     let mut parent: Vec<usize> = (0..n).collect();
     let mut offset = vec![[0i32; 2]; n];
     let mut wraps = [false; 2];
     let resolve = |i: usize| p.master[i].unwrap_or((i, [0, 0]));
-    for e in model.elements() {
-        let (a, sa) = resolve(e.nodes[0]);
-        let (b, sb) = resolve(e.nodes[1]);
+    let edges = model
+        .elements()
+        .iter()
+        .map(|e| e.nodes)
+        .chain(links.iter().copied());
+    for [na, nb] in edges {
+        let (a, sa) = resolve(na);
+        let (b, sb) = resolve(nb);
         // Node b's image sits at offset sb − sa from node a's image.
         let want = [sb[0] - sa[0], sb[1] - sa[1]];
         let (ra, oa) = find(&mut parent, &mut offset, a);

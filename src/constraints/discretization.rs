@@ -8,6 +8,7 @@
 //! the reduced system symmetric (thesis 4.42 with the periodic constraints folded in).
 
 use crate::cell::{macro_matrix, MacroStrain, Periodicity};
+use crate::contact::{ContactPair, Jump, JumpMatrix};
 use crate::model::{Dof, Model};
 use nalgebra::{DMatrix, SMatrix};
 
@@ -198,5 +199,24 @@ impl Discretization {
                 }
             })
             .collect()
+    }
+
+    /// A contact pair with its jump moved onto generalized nodes (B T).
+    pub fn contact_pair(&self, pair: &ContactPair) -> ContactPair {
+        if self.is_identity() {
+            return pair.clone();
+        }
+        let k = pair.jump.nodes.len();
+        let (gnodes, t) = self.block(&pair.jump.nodes);
+        let b = DMatrix::from_fn(3, 6 * k, |r, c| pair.jump.b[(r, c)]) * t;
+        let mut padded = JumpMatrix::zeros();
+        padded.view_mut((0, 0), (3, b.ncols())).copy_from(&b);
+        ContactPair {
+            jump: Jump {
+                nodes: gnodes,
+                b: padded,
+            },
+            ..pair.clone()
+        }
     }
 }

@@ -30,6 +30,8 @@ pub struct Homogenized {
     pub free_dofs: usize,
     /// Slave nodes eliminated by periodicity.
     pub paired_nodes: usize,
+    /// Closed contacts included in stick (the elastic moduli A^elas of thesis 5.5).
+    pub contacts: usize,
     /// Largest backward error of the six solves.
     pub backward_error: f64,
     /// Backend.
@@ -104,7 +106,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
         .map(|k| {
             let mut e = [0.0; 6];
             e[k] = 1.0;
-            sys.expand(model, &x[k * n..(k + 1) * n], &e)
+            sys.expand(&x[k * n..(k + 1) * n], &e)
         })
         .collect();
     Ok(Homogenized {
@@ -116,6 +118,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
         thickness: g.thickness,
         free_dofs: n,
         paired_nodes: sys.periodicity.n_slaves(),
+        contacts: sys.n_contacts(),
         backward_error: report.backward_error,
         backend: report.backend.to_string(),
         cases,

@@ -1,25 +1,17 @@
-//! The periodic cell as a linear system. Slave nodes (on the faces x = x₀ + L_x, y = y₀ + L_y)
-//! are eliminated master–slave: u_slave = u_master + (M(x_slave) − M(x_master)) E, with M the
-//! plate kinematics of [`crate::cell::macro_matrix`] and E the six macroscopic quantities, which
-//! become a seventh "node" of six driver DOFs. Every element matrix is transformed, Tᵀ K T, so
-//! the reduced system stays symmetric positive definite; the reactions of the driver DOFs are
-//! the stress resultants times the cell area. One independent node has its translations fixed
-//! to remove the rigid translations (the only rigid motions the periodicity leaves), which does
-//! not over-constrain anything.
+//! The periodic cell as a linear system on the periodic [`Discretization`]: slave nodes are
+//! eliminated master–slave, u_slave = u_master + (M(x_slave) − M(x_master)) E, with the six
+//! macroscopic quantities E as driver DOFs; element and contact matrices become Tᵀ K T, so the
+//! reduced system stays symmetric positive definite; the reactions of the drivers are the stress
+//! resultants times the cell area. Closed contacts (gap ≤ 0) enter as stick springs
+//! (K_N + K_T^st): the elastic moduli A^elas of thesis (5.5).
 
 use crate::assembly::{element_stiffness, Pattern, NO_SLOT};
-use crate::cell::{check_percolation, macro_matrix, pair_boundary_nodes, MacroStrain, Periodicity};
+use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain, Periodicity};
+use crate::constraints::Discretization;
+use crate::contact::{ContactPair, ContactSet, ContactSide};
 use crate::model::{Dof, Model};
 use crate::Error;
-use nalgebra::{SMatrix, SVector};
-
-/// How the 12 DOFs of an element map onto its generalized nodes (independent nodes and the
-/// driver node): q_element = T q_generalized.
-#[derive(Clone, Debug)]
-struct ElementMap {
-    gnodes: Vec<usize>,
-    t: SMatrix<f64, 12, 18>,
-}
+use nalgebra::{DMatrix, SMatrix, Vector2};
 
 /// The assembled values of a periodic cell problem.
 #[derive(Clone, Debug)]
@@ -32,144 +24,120 @@ pub struct PeriodicValues {
     pub k_ee: SMatrix<f64, 6, 6>,
 }
 
-/// Numbering, pattern and element maps of a periodic cell.
+/// Numbering, pattern and block maps of a periodic cell.
 #[derive(Clone, Debug)]
 pub struct PeriodicSystem {
     /// Pairing and geometry.
     pub periodicity: Periodicity,
-    n_nodes: usize,
-    reduced: Vec<usize>,
-    /// (node, DOF) of every free unknown.
-    free: Vec<(usize, Dof)>,
-    /// Sparsity pattern of K_ff with element slot maps.
+    /// Unknowns and constraint maps (drivers prescribed to zero).
+    pub discretization: Discretization,
+    /// Sparsity pattern of K_ff: elements, then closed contacts.
     pub pattern: Pattern,
-    maps: Vec<ElementMap>,
+    elements: Vec<(Vec<usize>, DMatrix<f64>)>,
+    contacts: Vec<ContactPair>,
     /// The node whose translations are fixed.
     pub anchor: usize,
 }
 
+/// Node pairs joined by the contact pairs (for connectivity checks).
+pub(crate) fn contact_links(model: &Model, set: &ContactSet) -> Vec<[usize; 2]> {
+    let node = |s: ContactSide| match s {
+        ContactSide::Node(n) => n,
+        ContactSide::Point { element, .. } => model.elements()[element].nodes[0],
+    };
+    set.origins
+        .iter()
+        .map(|o| [node(o.sides[0]), node(o.sides[1])])
+        .collect()
+}
+
 impl PeriodicSystem {
-    /// Pairs the boundary, checks percolation, numbers the unknowns and builds the pattern.
+    /// Pairs the boundary, finds the contacts, checks percolation, numbers the unknowns and
+    /// builds the pattern.
     pub fn new(model: &Model) -> Result<Self, Error> {
         let periodicity = pair_boundary_nodes(model)?;
-        check_percolation(model, &periodicity)?;
         if !model.supports.is_empty() {
             return Err(Error::InvalidOption(
                 "a periodic cell is driven by macroscopic strains: remove its [[supports]]".into(),
             ));
         }
-        let g = &periodicity.geometry;
-        let n = model.nodes.len();
-        let driver = n;
-        let centre = [g.origin[0] + 0.5 * g.size[0], g.origin[1] + 0.5 * g.size[1]];
-        let anchor = (0..n)
-            .filter(|&i| periodicity.master[i].is_none())
-            .min_by(|&a, &b| {
-                let d = |i: usize| {
-                    (model.nodes[i].x[0] - centre[0]).powi(2)
-                        + (model.nodes[i].x[1] - centre[1]).powi(2)
-                };
-                d(a).total_cmp(&d(b))
-            })
-            .ok_or(crate::cell::CellError::NotACell)?;
-        let mut reduced = vec![usize::MAX; 6 * (n + 1)];
-        let mut free = Vec::new();
-        for i in 0..n {
-            if periodicity.master[i].is_some() {
-                continue;
-            }
-            for d in 0..6 {
-                if i == anchor && d < 3 {
-                    continue;
-                }
-                reduced[6 * i + d] = free.len();
-                free.push((i, Dof::ALL[d]));
-            }
-        }
-        let mut maps = Vec::with_capacity(model.elements().len());
-        for e in model.elements() {
-            let mut gnodes: Vec<usize> = Vec::with_capacity(3);
-            let mut t = SMatrix::<f64, 12, 18>::zeros();
-            let column = |gnodes: &mut Vec<usize>, gnode: usize| match gnodes
-                .iter()
-                .position(|&x| x == gnode)
-            {
-                Some(k) => k,
-                None => {
-                    gnodes.push(gnode);
-                    gnodes.len() - 1
-                }
-            };
-            for (k, &node) in e.nodes.iter().enumerate() {
-                match periodicity.master[node] {
-                    None => {
-                        let c = column(&mut gnodes, node);
-                        t.fixed_view_mut::<6, 6>(6 * k, 6 * c)
-                            .copy_from(&SMatrix::<f64, 6, 6>::identity());
-                    }
-                    Some((m, _)) => {
-                        let c = column(&mut gnodes, m);
-                        let mut block = t.fixed_view_mut::<6, 6>(6 * k, 6 * c);
-                        block += SMatrix::<f64, 6, 6>::identity();
-                        let xs = g.relative(&model.nodes[node].x);
-                        let xm = g.relative(&model.nodes[m].x);
-                        let jump =
-                            macro_matrix(xs[0], xs[1], xs[2]) - macro_matrix(xm[0], xm[1], xm[2]);
-                        let c = column(&mut gnodes, driver);
-                        let mut block = t.fixed_view_mut::<6, 6>(6 * k, 6 * c);
-                        block += jump;
-                    }
-                }
-            }
-            maps.push(ElementMap { gnodes, t });
-        }
-        let blocks: Vec<&[usize]> = maps.iter().map(|m| &m.gnodes[..]).collect();
-        let pattern = Pattern::from_blocks(&reduced, free.len(), &blocks, blocks.len())?;
+        let set = ContactSet::build(model)?;
+        let closed: Vec<usize> = (0..set.pairs.len())
+            .filter(|&i| set.pairs[i].gap <= 0.0)
+            .collect();
+        let links: Vec<[usize; 2]> = {
+            let all = contact_links(model, &set);
+            closed.iter().map(|&i| all[i]).collect()
+        };
+        check_percolation(model, &periodicity, &links)?;
+        let anchor = anchor_node(model, &periodicity)?;
+        let discretization = Discretization::periodic(model, &periodicity, &[0.0; 6], anchor);
+        let elements: Vec<(Vec<usize>, DMatrix<f64>)> = model
+            .elements()
+            .iter()
+            .map(|e| discretization.block(&e.nodes))
+            .collect();
+        let contacts: Vec<ContactPair> = closed
+            .iter()
+            .map(|&i| discretization.contact_pair(&set.pairs[i]))
+            .collect();
+        let blocks: Vec<&[usize]> = elements
+            .iter()
+            .map(|(g, _)| &g[..])
+            .chain(contacts.iter().map(|c| &c.jump.nodes[..]))
+            .collect();
+        let pattern = Pattern::from_blocks(
+            discretization.reduced_indices(),
+            discretization.n_free(),
+            &blocks,
+            elements.len(),
+        )?;
         Ok(PeriodicSystem {
             periodicity,
-            n_nodes: n,
-            reduced,
-            free,
+            discretization,
             pattern,
-            maps,
+            elements,
+            contacts,
             anchor,
         })
     }
 
     /// Number of unknowns.
     pub fn n_free(&self) -> usize {
-        self.free.len()
+        self.discretization.n_free()
     }
 
     /// (node, DOF) of a free unknown.
     pub fn node_dof(&self, k: usize) -> (usize, Dof) {
-        self.free[k]
+        self.discretization.node_dof(k)
     }
 
-    /// Assembles K_ff, K_fE and K_EE.
+    /// Number of closed contacts included as stick springs.
+    pub fn n_contacts(&self) -> usize {
+        self.contacts.len()
+    }
+
+    /// Assembles K_ff, K_fE and K_EE (elements and closed contacts in stick).
     pub fn assemble(&self, model: &Model) -> PeriodicValues {
+        let disc = &self.discretization;
+        let driver = disc.driver().unwrap_or(usize::MAX);
         let mut out = PeriodicValues {
             values: vec![0.0; self.pattern.nnz()],
-            coupling: vec![[0.0; 6]; self.free.len()],
+            coupling: vec![[0.0; 6]; disc.n_free()],
             k_ee: SMatrix::zeros(),
         };
-        for (e, map) in self.maps.iter().enumerate() {
-            let k = element_stiffness(model, e);
-            let m = 6 * map.gnodes.len();
-            let kt: SMatrix<f64, 18, 18> = map.t.transpose() * k * map.t;
-            let slots = self.pattern.element_slots(e);
-            let gdof = |r: usize| 6 * map.gnodes[r / 6] + r % 6;
+        let mut scatter = |gnodes: &[usize], k: &DMatrix<f64>, slots: &[u32]| {
+            let m = 6 * gnodes.len();
+            let gdof = |r: usize| 6 * gnodes[r / 6] + r % 6;
             for r in 0..m {
-                let driver_r = map.gnodes[r / 6] == self.n_nodes;
+                let driver_r = gnodes[r / 6] == driver;
                 for c in 0..m {
-                    let v = kt[(r, c)];
-                    let driver_c = map.gnodes[c / 6] == self.n_nodes;
+                    let v = k[(r, c)];
+                    let driver_c = gnodes[c / 6] == driver;
                     match (driver_r, driver_c) {
                         (true, true) => out.k_ee[(r % 6, c % 6)] += v,
                         (false, true) => {
-                            if let Some(&i) =
-                                Some(&self.reduced[gdof(r)]).filter(|&&i| i != usize::MAX)
-                            {
+                            if let Some(i) = disc.reduced(gdof(r)) {
                                 out.coupling[i][c % 6] += v;
                             }
                         }
@@ -182,37 +150,33 @@ impl PeriodicSystem {
                     }
                 }
             }
+        };
+        for (e, (gnodes, t)) in self.elements.iter().enumerate() {
+            let k = element_stiffness(model, e);
+            let k = DMatrix::from_fn(12, 12, |r, c| k[(r, c)]);
+            scatter(
+                gnodes,
+                &(t.transpose() * k * t),
+                self.pattern.element_slots(e),
+            );
+        }
+        for (i, pair) in self.contacts.iter().enumerate() {
+            let m = pair.size();
+            let (kn, _) = pair.normal();
+            let (kt, _) = pair.stick(&Vector2::zeros());
+            let k = DMatrix::from_fn(m, m, |r, c| kn[(r, c)] + kt[(r, c)]);
+            scatter(&pair.jump.nodes, &k, self.pattern.extra_slots(i));
         }
         out
     }
 
     /// Nodal displacements and rotations of every node for the unknowns `x` and the drivers `e`.
-    pub fn expand(&self, model: &Model, x: &[f64], e: &MacroStrain) -> Vec<[f64; 6]> {
-        let g = &self.periodicity.geometry;
-        let own = |i: usize| {
-            let mut u = [0.0; 6];
-            for (d, v) in u.iter_mut().enumerate() {
-                let r = self.reduced[6 * i + d];
-                if r != usize::MAX {
-                    *v = x[r];
-                }
-            }
-            u
-        };
-        let es = SVector::<f64, 6>::from(*e);
-        (0..self.n_nodes)
-            .map(|i| match self.periodicity.master[i] {
-                None => own(i),
-                Some((m, _)) => {
-                    let xs = g.relative(&model.nodes[i].x);
-                    let xm = g.relative(&model.nodes[m].x);
-                    let jump = (macro_matrix(xs[0], xs[1], xs[2])
-                        - macro_matrix(xm[0], xm[1], xm[2]))
-                        * es;
-                    let um = own(m);
-                    [0, 1, 2, 3, 4, 5].map(|d| um[d] + jump[d])
-                }
-            })
-            .collect()
+    pub fn expand(&self, x: &[f64], e: &MacroStrain) -> Vec<[f64; 6]> {
+        let disc = &self.discretization;
+        let mut q = disc.generalized(x, 0.0);
+        if let Some(d) = disc.driver() {
+            q[6 * d..6 * d + 6].copy_from_slice(e);
+        }
+        disc.physical(&q)
     }
 }

@@ -408,20 +408,7 @@ pub(crate) fn run_incremental(
             vec![None; set.pairs.len()]
         };
     // Contact jumps on generalized nodes: B T.
-    let mut pairs = set.pairs.clone();
-    if !disc.is_identity() {
-        for p in &mut pairs {
-            let k = p.jump.nodes.len();
-            let (gnodes, t) = disc.block(&p.jump.nodes);
-            let b = DMatrix::from_fn(3, 6 * k, |r, c| p.jump.b[(r, c)]) * t;
-            let mut padded = crate::contact::JumpMatrix::zeros();
-            padded.view_mut((0, 0), (3, b.ncols())).copy_from(&b);
-            p.jump = crate::contact::Jump {
-                nodes: gnodes,
-                b: padded,
-            };
-        }
-    }
+    let pairs: Vec<ContactPair> = set.pairs.iter().map(|p| disc.contact_pair(p)).collect();
     let elastic = Elastic::new(model, disc);
     let mut blocks: Vec<Vec<usize>> = (0..model.elements().len())
         .map(|e| elastic.gnodes(model, e))
