@@ -13,8 +13,10 @@
 //!   D66 = GJ (Lx + Ly) / (4 Lx Ly);
 //! * B = 0 (all fibers in the mid-surface).
 
+mod common;
+use common::GridCell;
 use fibercell::homogenize::{homogenize_elastic, Homogenized};
-use fibercell::model::{CellSpec, FiberSpec, MaterialSpec, ModelDescription, NodeSpec};
+use fibercell::model::ModelDescription;
 use fibercell::solve::SolveOptions;
 use fibercell::{Error, Model};
 use std::f64::consts::PI;
@@ -23,8 +25,6 @@ const E: f64 = 1.0e9;
 const NU: f64 = 0.3;
 const R: f64 = 2e-4;
 
-/// `nx` × `ny` periods of the grid, joints at (jx + i Lx, jy + j Ly), `sub` elements per
-/// segment between a joint and a cell face.
 fn grid_cell(
     lx: f64,
     ly: f64,
@@ -34,78 +34,16 @@ fn grid_cell(
     ny: usize,
     sub: usize,
 ) -> ModelDescription {
-    let mut d = ModelDescription {
-        materials: vec![MaterialSpec {
-            name: "m".into(),
-            young: E,
-            poisson: Some(NU),
-            shear: None,
-        }],
-        cell: Some(CellSpec {
-            size: [nx as f64 * lx, ny as f64 * ly],
-            origin: Some([0.0, 0.0]),
-            thickness: Some(2.0 * R),
-            tolerance: None,
-        }),
-        ..Default::default()
-    };
-    let mut ids = std::collections::HashMap::new();
-    let mut node = |d: &mut ModelDescription, x: f64, y: f64| -> u64 {
-        let key = ((x * 1e9).round() as i64, (y * 1e9).round() as i64);
-        if let Some(&id) = ids.get(&key) {
-            return id;
-        }
-        let id = d.nodes.len() as u64 + 1;
-        d.nodes.push(NodeSpec { id, x: [x, y, 0.0] });
-        ids.insert(key, id);
-        id
-    };
-    // Stations along a line through the cell: the faces and the joints, each gap split in `sub`.
-    let stations = |len: f64, joint: f64, n: usize| {
-        let mut s = vec![0.0];
-        for k in 0..n {
-            s.push(k as f64 * len + joint);
-        }
-        s.push(n as f64 * len);
-        let mut out = Vec::new();
-        for w in s.windows(2) {
-            for q in 0..sub {
-                out.push(w[0] + (w[1] - w[0]) * q as f64 / sub as f64);
-            }
-        }
-        out.push(n as f64 * len);
-        out
-    };
-    let mut fid = 0;
-    for j in 0..ny {
-        let y = jy + j as f64 * ly;
-        let nodes: Vec<u64> = stations(lx, jx, nx)
-            .into_iter()
-            .map(|x| node(&mut d, x, y))
-            .collect();
-        fid += 1;
-        d.fibers.push(FiberSpec {
-            id: fid,
-            nodes,
-            radius: R,
-            material: "m".into(),
-        });
+    GridCell {
+        young: E,
+        poisson: NU,
+        radius: R,
+        size: [lx, ly],
+        joint: [jx, jy],
+        periods: [nx, ny],
+        sub,
     }
-    for i in 0..nx {
-        let x = jx + i as f64 * lx;
-        let nodes: Vec<u64> = stations(ly, jy, ny)
-            .into_iter()
-            .map(|y| node(&mut d, x, y))
-            .collect();
-        fid += 1;
-        d.fibers.push(FiberSpec {
-            id: fid,
-            nodes,
-            radius: R,
-            material: "m".into(),
-        });
-    }
-    d
+    .build()
 }
 
 fn homogenize(d: &ModelDescription) -> Homogenized {

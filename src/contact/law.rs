@@ -143,6 +143,22 @@ impl ContactPair {
         (k, f)
     }
 
+    /// The consistent tangent of the radial return perpendicular to the slip direction `d`: a
+    /// spring k⊥ = p_T · bound / |trial| acting on the tangential displacement across `d`,
+    /// anchored at the current iterate's tangential displacement `anchor`. It vanishes at
+    /// convergence and makes the slip-direction iteration Newton's method (without it a sliding
+    /// contact offers no resistance across its direction, and the direction can oscillate).
+    pub fn slip_perpendicular(
+        &self,
+        d: &Vector2<f64>,
+        k_perp: f64,
+        anchor: &Vector2<f64>,
+    ) -> (BlockMatrix, BlockVector) {
+        let p = Vector2::new(-d[1], d[0]);
+        let bp = self.bt_e(&p);
+        (bp * bp.transpose() * k_perp, bp * (k_perp * p.dot(anchor)))
+    }
+
     /// K_T^sl and F_T^sl of a contact sliding along the unit direction `d` (tangent basis).
     pub fn slip(&self, friction: Friction, d: &Vector2<f64>) -> (BlockMatrix, BlockVector) {
         let bd = self.bt_e(d);

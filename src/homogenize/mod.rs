@@ -2,10 +2,12 @@
 //! problems driven by unit macroscopic strains, the ABD stiffness per unit cell area, the
 //! thesis's moduli and the orthotropic constants of §5.1.2.
 
+mod curve;
 mod elastic;
 mod orthotropic;
-mod system;
+pub(crate) mod system;
 
+pub use curve::{elasto_plastic_curve, Curve, CurveOptions, CurvePoint, Segment, SwitchEvent};
 pub use elastic::{homogenize_elastic, Homogenized};
 pub use orthotropic::{Orthotropic, ThesisModuli};
 pub use system::PeriodicSystem;

@@ -29,6 +29,9 @@ pub struct IncrementalOptions {
     pub solve: SolveOptions,
     /// Largest number of state iterations inside one increment.
     pub max_state_iterations: usize,
+    /// Load factors of the increments (default: α_n = n/N, n = 1…N); any sequence, e.g. up to 1,
+    /// back to 0 and up again for a load–unload–reload path. Overrides `steps`.
+    pub path: Option<Vec<f64>>,
     /// Thesis Remark 4.38: every contact slides along the direction of its tangential relative
     /// displacement in a frictionless pre-run, instead of the trial direction of the return
     /// mapping (the default, and the more faithful treatment).
@@ -41,6 +44,7 @@ impl Default for IncrementalOptions {
             steps: 10,
             solve: SolveOptions::default(),
             max_state_iterations: 50,
+            path: None,
             fixed_slip_direction: false,
         }
     }
@@ -71,6 +75,8 @@ pub struct IncrementRecord {
     /// times the cell area).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub macro_reaction: Option<[f64; 6]>,
+    /// Energy dissipated by sliding since the start, Σ F_t · Δs (J).
+    pub dissipated: f64,
     /// Backend of the last solve.
     pub backend: String,
     /// Backward error of the last solve.
@@ -125,6 +131,7 @@ struct Trial {
     bound: f64,
     relative: Vector2<f64>,
     penetration: f64,
+    trial_norm: f64,
 }
 
 /// Return mapping of one contact for the block displacement `q` and committed slip `s`.
@@ -136,10 +143,11 @@ fn classify(
     friction: Friction,
     q: &BlockVector,
     slip: &Vector2<f64>,
-    previous: ContactState,
+    previous: (ContactState, Vector2<f64>),
     length_tol: f64,
     fixed_direction: Option<Vector2<f64>>,
 ) -> Trial {
+    let (previous, previous_direction) = previous;
     let kin = pair.kinematics(q);
     let mut t = Trial {
         state: ContactState::Open,
@@ -149,6 +157,7 @@ fn classify(
         bound: 0.0,
         relative: kin.tangential,
         penetration: kin.penetration,
+        trial_norm: 0.0,
     };
     let closed_before = previous != ContactState::Open;
     let closes = if closed_before {
@@ -162,6 +171,7 @@ fn classify(
     t.normal_force = pair.penalty_normal * kin.penetration.max(0.0);
     let trial = (kin.tangential - slip) * pair.penalty_tangent;
     let norm = trial.norm();
+    t.trial_norm = norm;
     t.direction = if norm > 0.0 {
         trial / norm
     } else {
@@ -178,6 +188,14 @@ fn classify(
         1.0 + 1e-10
     };
     if friction != Friction::None && norm <= t.bound * margin {
+        t.state = ContactState::Stick;
+        t.tangential = trial;
+    } else if previous == ContactState::Slip
+        && friction != Friction::None
+        && t.direction.dot(&previous_direction) < 0.0
+    {
+        // A sliding contact cannot reverse without passing through stick: try stick first
+        // (the solve under the old slip force says nothing about the elastic range).
         t.state = ContactState::Stick;
         t.tangential = trial;
     } else {
@@ -365,10 +383,21 @@ pub(crate) fn run_incremental(
     set: ContactSet,
     opts: &IncrementalOptions,
 ) -> Result<IncrementalSolution, Error> {
-    if opts.steps == 0 {
+    let path: Vec<f64> = match &opts.path {
+        Some(p) => p.clone(),
+        None => (1..=opts.steps)
+            .map(|n| n as f64 / opts.steps as f64)
+            .collect(),
+    };
+    if path.is_empty() {
         return Err(Error::InvalidOption(
             "the number of increments must be at least 1".into(),
         ));
+    }
+    if let Some(a) = path.iter().find(|a| !a.is_finite()) {
+        return Err(Error::InvalidOption(format!(
+            "load factor {a} is not finite"
+        )));
     }
     if opts.max_state_iterations == 0 {
         return Err(Error::InvalidOption(
@@ -468,17 +497,19 @@ pub(crate) fn run_incremental(
     let mut states: Vec<ContactState> = pairs.iter().map(initial).collect();
     let mut directions: Vec<Vector2<f64>> = vec![Vector2::zeros(); pairs.len()];
     let mut slips: Vec<Vector2<f64>> = vec![Vector2::zeros(); pairs.len()];
+    // Consistent tangent across the slip direction: (k⊥, anchor) per contact.
+    let mut perpendicular: Vec<(f64, Vector2<f64>)> = vec![(0.0, Vector2::zeros()); pairs.len()];
     // What the current factorization was built from (None: nothing factorized yet).
-    let mut factorized: Option<(bool, Vec<ContactState>, Vec<Vector2<f64>>)> = None;
+    let mut factorized: Option<(bool, Vec<ContactState>, Vec<Vector2<f64>>, Vec<f64>)> = None;
 
     let length_tol = 1e-12 * model_size(model);
     let mut values = k_elastic.clone();
     let mut q = vec![0.0; 6 * disc.n_gnodes()];
     let mut out = IncrementalSolution {
         contacts: set.clone(),
-        increments: Vec::with_capacity(opts.steps),
-        contact_results: Vec::with_capacity(opts.steps),
-        displacements: Vec::with_capacity(opts.steps),
+        increments: Vec::with_capacity(path.len()),
+        contact_results: Vec::with_capacity(path.len()),
+        displacements: Vec::with_capacity(path.len()),
         reactions: Vec::new(),
     };
     let gather = |q: &[f64], nodes: &[usize]| {
@@ -491,8 +522,8 @@ pub(crate) fn run_incremental(
         v
     };
 
-    for step in 1..=opts.steps {
-        let alpha = step as f64 / opts.steps as f64;
+    let mut dissipated = 0.0;
+    for (step, &alpha) in (1..).zip(&path) {
         let mut factorizations = 0;
         let mut converged = None;
         for iteration in 1..=opts.max_state_iterations {
@@ -511,7 +542,17 @@ pub(crate) fn run_incremental(
                     ContactState::Stick => pair.stick(&slips[i]),
                     _ => {
                         nonsymmetric |= matches!(friction, Friction::Coulomb { mu } if mu > 0.0);
-                        pair.slip(friction, &directions[i])
+                        let (mut k, mut f) = pair.slip(friction, &directions[i]);
+                        if perpendicular[i].0 > 0.0 {
+                            let (kp, fp) = pair.slip_perpendicular(
+                                &directions[i],
+                                perpendicular[i].0,
+                                &perpendicular[i].1,
+                            );
+                            k += kp;
+                            f += fp;
+                        }
+                        (k, f)
                     }
                 };
                 k += kt;
@@ -551,7 +592,12 @@ pub(crate) fn run_incremental(
             let solver = slot
                 .as_mut()
                 .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "analyze")))?;
-            let key = (nonsymmetric, states.clone(), directions.clone());
+            let key = (
+                nonsymmetric,
+                states.clone(),
+                directions.clone(),
+                perpendicular.iter().map(|p| p.0).collect::<Vec<f64>>(),
+            );
             if factorized.as_ref() != Some(&key) {
                 solver.factorize(a).map_err(locate)?;
                 factorizations += 1;
@@ -583,7 +629,7 @@ pub(crate) fn run_incremental(
                         friction,
                         &gather(&q, &p.jump.nodes),
                         &slips[i],
-                        states[i],
+                        (states[i], directions[i]),
                         length_tol,
                         fixed[i],
                     )
@@ -613,6 +659,16 @@ pub(crate) fn run_incremental(
                 states[i] = trials[i].state;
                 directions[i] = trials[i].direction;
             }
+            for (i, t) in trials.iter().enumerate() {
+                perpendicular[i] = if t.state == ContactState::Slip && t.trial_norm > 0.0 {
+                    (
+                        pairs[i].penalty_tangent * t.bound / t.trial_norm,
+                        t.relative,
+                    )
+                } else {
+                    (0.0, Vector2::zeros())
+                };
+            }
         }
         let Some((iterations, trials, report)) = converged else {
             return Err(Error::InvalidOption("no state iteration ran".into()));
@@ -623,7 +679,11 @@ pub(crate) fn run_incremental(
         for (i, (pair, t)) in pairs.iter().zip(&trials).enumerate() {
             match t.state {
                 ContactState::Open => slips[i] = t.relative,
-                ContactState::Slip => slips[i] = t.relative - t.tangential / pair.penalty_tangent,
+                ContactState::Slip => {
+                    let new = t.relative - t.tangential / pair.penalty_tangent;
+                    dissipated += t.tangential.dot(&(new - slips[i]));
+                    slips[i] = new;
+                }
                 ContactState::Stick => {}
             }
             let ft: Vector3<f64> =
@@ -682,6 +742,7 @@ pub(crate) fn run_incremental(
             applied_load: applied_full.map(|v| alpha * v),
             reaction,
             macro_reaction,
+            dissipated,
             backend: backend.to_string(),
             backward_error: bwd,
         });

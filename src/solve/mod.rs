@@ -8,6 +8,7 @@ mod static_solve;
 
 pub use backend::{make_solver, SolverKind};
 pub use connectivity::{check_supported, check_supported_with};
+pub(crate) use incremental::run_incremental;
 pub use incremental::{
     solve_incremental, ContactRecord, IncrementRecord, IncrementalOptions, IncrementalSolution,
 };

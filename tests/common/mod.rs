@@ -123,3 +123,97 @@ pub fn quadrature_local_stiffness(
     }
     k
 }
+
+/// A periodic cell of a rectangular grid with fixed junctions: `periods` = (nx, ny) periods of
+/// (L_x, L_y), joints at (jx + i L_x, jy + j L_y), `sub` elements per segment between a joint and
+/// a cell face; x-fibers first (ids 1…ny), then y-fibers.
+pub struct GridCell {
+    pub young: f64,
+    pub poisson: f64,
+    pub radius: f64,
+    pub size: [f64; 2],
+    pub joint: [f64; 2],
+    pub periods: [usize; 2],
+    pub sub: usize,
+}
+
+impl GridCell {
+    pub fn build(&self) -> ModelDescription {
+        use fibercell::model::CellSpec;
+        let [lx, ly] = self.size;
+        let [jx, jy] = self.joint;
+        let [nx, ny] = self.periods;
+        let sub = self.sub;
+        let mut d = ModelDescription {
+            materials: vec![MaterialSpec {
+                name: "m".into(),
+                young: self.young,
+                poisson: Some(self.poisson),
+                shear: None,
+            }],
+            cell: Some(CellSpec {
+                size: [nx as f64 * lx, ny as f64 * ly],
+                origin: Some([0.0, 0.0]),
+                thickness: Some(2.0 * self.radius),
+                tolerance: None,
+            }),
+            ..Default::default()
+        };
+        let mut ids = std::collections::HashMap::new();
+        let mut node = |d: &mut ModelDescription, x: f64, y: f64| -> u64 {
+            let key = ((x * 1e9).round() as i64, (y * 1e9).round() as i64);
+            if let Some(&id) = ids.get(&key) {
+                return id;
+            }
+            let id = d.nodes.len() as u64 + 1;
+            d.nodes.push(NodeSpec { id, x: [x, y, 0.0] });
+            ids.insert(key, id);
+            id
+        };
+        let stations = |len: f64, joint: f64, n: usize| {
+            let mut s = vec![0.0];
+            for k in 0..n {
+                s.push(k as f64 * len + joint);
+            }
+            s.push(n as f64 * len);
+            let mut out = Vec::new();
+            for w in s.windows(2) {
+                for q in 0..sub {
+                    out.push(w[0] + (w[1] - w[0]) * q as f64 / sub as f64);
+                }
+            }
+            out.push(n as f64 * len);
+            out
+        };
+        let mut fid = 0;
+        for j in 0..ny {
+            let y = jy + j as f64 * ly;
+            let nodes: Vec<u64> = stations(lx, jx, nx)
+                .into_iter()
+                .map(|x| node(&mut d, x, y))
+                .collect();
+            fid += 1;
+            d.fibers.push(FiberSpec {
+                id: fid,
+                nodes,
+                radius: self.radius,
+                material: "m".into(),
+            });
+        }
+        for i in 0..nx {
+            let x = jx + i as f64 * lx;
+            let nodes: Vec<u64> = stations(ly, jy, ny)
+                .into_iter()
+                .map(|y| node(&mut d, x, y))
+                .collect();
+            fid += 1;
+            d.fibers.push(FiberSpec {
+                id: fid,
+                nodes,
+                radius: self.radius,
+                material: "m".into(),
+            });
+        }
+        d
+    }
+}

@@ -1,0 +1,202 @@
+//! The friction-driven elasto-plastic curve of a cell (thesis §5.1.2): a macroscopic strain path
+//! ramped over increments with the stick/slip solver, the averaged stress resultants against
+//! strain, the strain at which each contact switches, the piecewise-linear segments (one per
+//! switch), the elastic/plastic split (5.5–5.6) and the dissipated energy.
+
+use super::homogenize_elastic;
+use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain};
+use crate::constraints::Discretization;
+use crate::contact::ContactSet;
+use crate::model::Model;
+use crate::solve::{run_incremental, IncrementalOptions, IncrementalSolution};
+use crate::Error;
+use serde::Serialize;
+
+/// Options of [`elasto_plastic_curve`].
+#[derive(Clone, Debug)]
+pub struct CurveOptions {
+    /// The macroscopic strain reached at the end of loading, E = (ε11, ε22, γ12, κ11, κ22, κ12).
+    pub strain: MacroStrain,
+    /// Increments of the loading branch.
+    pub steps: usize,
+    /// Unload to zero and reload to `strain` (hysteresis).
+    pub unload: bool,
+    /// Solver and state-iteration settings (`steps` and `path` are set from the above).
+    pub incremental: IncrementalOptions,
+}
+
+/// One point of the curve.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CurvePoint {
+    /// Increment.
+    pub step: usize,
+    /// Load factor along the path.
+    pub alpha: f64,
+    /// Macroscopic strain α E.
+    pub strain: [f64; 6],
+    /// Averaged stress resultants (N11, N22, N12 in N/m; M11, M22, M12 in N).
+    pub resultant: [f64; 6],
+    /// The all-stick elastic part A^elas α E (5.5).
+    pub elastic: [f64; 6],
+    /// resultant − elastic: the part lost to sliding (5.5–5.6).
+    pub plastic: [f64; 6],
+    /// Contacts open, stuck, sliding.
+    pub open: usize,
+    /// Stuck contacts.
+    pub stick: usize,
+    /// Sliding contacts.
+    pub slip: usize,
+    /// Dissipated energy per unit cell area so far (J/m²).
+    pub dissipated: f64,
+}
+
+/// A contact changing state.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SwitchEvent {
+    /// Contact (1-based).
+    pub contact: usize,
+    /// Increment at which the new state is first seen.
+    pub step: usize,
+    /// Macroscopic strain there.
+    pub strain: [f64; 6],
+    /// Previous state.
+    pub from: &'static str,
+    /// New state.
+    pub to: &'static str,
+}
+
+/// A linear piece of the curve between switches.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Segment {
+    /// First and last increment (the segment starts at the end of the increment before).
+    pub steps: [usize; 2],
+    /// d(resultant)/dα over the piece.
+    pub slope: [f64; 6],
+}
+
+/// The curve and everything derived from it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Curve {
+    /// The all-stick elastic ABD used for the split.
+    pub elastic_abd: [[f64; 6]; 6],
+    /// Points, one per increment.
+    pub points: Vec<CurvePoint>,
+    /// State switches in order.
+    pub switches: Vec<SwitchEvent>,
+    /// Linear pieces between switches.
+    pub segments: Vec<Segment>,
+    /// The underlying incremental solution.
+    #[serde(skip)]
+    pub solution: IncrementalSolution,
+}
+
+/// Ramps the macroscopic strain of a periodic cell with contacts along `opts`.
+pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve, Error> {
+    if let Some(v) = opts.strain.iter().find(|v| !v.is_finite()) {
+        return Err(Error::InvalidOption(format!(
+            "macroscopic strain component {v} is not finite"
+        )));
+    }
+    if opts.steps == 0 {
+        return Err(Error::InvalidOption(
+            "the number of increments must be at least 1".into(),
+        ));
+    }
+    let elastic = homogenize_elastic(model, &opts.incremental.solve)?;
+    let p = pair_boundary_nodes(model)?;
+    let set = ContactSet::build(model)?;
+    let links = crate::homogenize::system::contact_links(model, &set);
+    check_percolation(model, &p, &links)?;
+    let anchor = anchor_node(model, &p)?;
+    let disc = Discretization::periodic(model, &p, &opts.strain, anchor);
+    let n = opts.steps;
+    let mut path: Vec<f64> = (1..=n).map(|k| k as f64 / n as f64).collect();
+    if opts.unload {
+        path.extend((0..n).rev().map(|k| k as f64 / n as f64));
+        path.extend((1..=n).map(|k| k as f64 / n as f64));
+    }
+    let inc = IncrementalOptions {
+        steps: path.len(),
+        path: Some(path),
+        ..opts.incremental.clone()
+    };
+    let sol = run_incremental(model, &disc, set, &inc)?;
+    let area = p.geometry.area();
+    let mut points = Vec::with_capacity(sol.increments.len());
+    for r in &sol.increments {
+        let strain = opts.strain.map(|e| r.alpha * e);
+        let resultant = r.macro_reaction.unwrap_or([0.0; 6]).map(|v| v / area);
+        let el: [f64; 6] =
+            std::array::from_fn(|i| (0..6).map(|j| elastic.abd[i][j] * strain[j]).sum());
+        points.push(CurvePoint {
+            step: r.step,
+            alpha: r.alpha,
+            strain,
+            resultant,
+            elastic: el,
+            plastic: std::array::from_fn(|i| resultant[i] - el[i]),
+            open: r.open,
+            stick: r.stick,
+            slip: r.slip,
+            dissipated: r.dissipated / area,
+        });
+    }
+    // Switches: a contact's state differs from the previous increment (initial: from the first).
+    let mut switches = Vec::new();
+    for k in 1..sol.contact_results.len() {
+        for (c, (now, before)) in sol.contact_results[k]
+            .iter()
+            .zip(&sol.contact_results[k - 1])
+            .enumerate()
+        {
+            if now.state != before.state {
+                switches.push(SwitchEvent {
+                    contact: c + 1,
+                    step: k + 1,
+                    strain: points[k].strain,
+                    from: before.state.name(),
+                    to: now.state.name(),
+                });
+            }
+        }
+    }
+    // Segments: break where any switch happens or the path turns.
+    let mut breaks: Vec<usize> = switches.iter().map(|s| s.step).collect();
+    for k in 1..points.len().saturating_sub(1) {
+        let (a, b, c) = (points[k - 1].alpha, points[k].alpha, points[k + 1].alpha);
+        if (b - a) * (c - b) < 0.0 {
+            breaks.push(k + 2);
+        }
+    }
+    breaks.sort_unstable();
+    breaks.dedup();
+    let mut segments = Vec::new();
+    let mut start = 1;
+    for end_excl in breaks.into_iter().chain(std::iter::once(points.len() + 1)) {
+        if end_excl <= start {
+            continue;
+        }
+        let last = end_excl - 1;
+        let (p0, a0) = if start == 1 {
+            ([0.0; 6], 0.0)
+        } else {
+            (points[start - 2].resultant, points[start - 2].alpha)
+        };
+        let p1 = &points[last - 1];
+        let da = p1.alpha - a0;
+        if da != 0.0 {
+            segments.push(Segment {
+                steps: [start, last],
+                slope: std::array::from_fn(|i| (p1.resultant[i] - p0[i]) / da),
+            });
+        }
+        start = end_excl;
+    }
+    Ok(Curve {
+        elastic_abd: elastic.abd,
+        points,
+        switches,
+        segments,
+        solution: sol,
+    })
+}
