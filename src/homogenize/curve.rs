@@ -153,7 +153,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
                 switches.push(SwitchEvent {
                     contact: c + 1,
                     step: k + 1,
-                    strain: points[k].strain,
+                    strain: point.strain,
                     from: before.state.name(),
                     to: now.state.name(),
                 });

@@ -242,6 +242,9 @@ fn model_size(model: &Model) -> f64 {
     (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
 }
 
+/// What an assembled matrix was built from: symmetry, states, slip directions, k⊥ of each contact.
+type AssembledKey = (bool, Vec<ContactState>, Vec<Vector2<f64>>, Vec<f64>);
+
 struct Backends {
     symmetric: Option<Box<dyn LinearSolver>>,
     general: Option<Box<dyn LinearSolver>>,
@@ -500,7 +503,7 @@ pub(crate) fn run_incremental(
     // Consistent tangent across the slip direction: (k⊥, anchor) per contact.
     let mut perpendicular: Vec<(f64, Vector2<f64>)> = vec![(0.0, Vector2::zeros()); pairs.len()];
     // What the current factorization was built from (None: nothing factorized yet).
-    let mut factorized: Option<(bool, Vec<ContactState>, Vec<Vector2<f64>>, Vec<f64>)> = None;
+    let mut factorized: Option<AssembledKey> = None;
 
     let length_tol = 1e-12 * model_size(model);
     let mut values = k_elastic.clone();
