@@ -143,7 +143,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
     }
     // Switches: a contact's state differs from the previous increment (initial: from the first).
     let mut switches = Vec::new();
-    for k in 1..sol.contact_results.len() {
+    for (k, point) in points.iter().enumerate().skip(1) {
         for (c, (now, before)) in sol.contact_results[k]
             .iter()
             .zip(&sol.contact_results[k - 1])
