@@ -36,14 +36,14 @@ fn cell(bound: f64) -> ModelDescription {
         }),
         ..Default::default()
     };
-    let mut add = |d: &mut ModelDescription, x: f64, y: f64| {
+    let add = |d: &mut ModelDescription, x: f64, y: f64| {
         let id = d.nodes.len() as u64 + 1;
         d.nodes.push(NodeSpec { id, x: [x, y, 0.0] });
         id
     };
     let (x_y, x_link, y1, y2) = (0.2 * LX, 0.6 * LX, 0.25 * LY, 0.75 * LY);
     // x-fibers through the joints at x_y and x_link, split in halves between stations.
-    let mut x_fiber = |d: &mut ModelDescription, y: f64| -> (Vec<u64>, u64, u64) {
+    let x_fiber = |d: &mut ModelDescription, y: f64| -> (Vec<u64>, u64, u64) {
         let xs = [
             0.0,
             0.5 * x_y,
