@@ -228,3 +228,61 @@ fn homogenize_prints_abd_and_writes_the_cell_problems() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("no [cell] section"));
 }
+
+#[test]
+fn curve_writes_csv_switches_json_and_svg() {
+    let out = tmpdir("curve");
+    let o = run(&[
+        "curve",
+        "fixtures/ok_cell_contact.toml",
+        "--strain",
+        "g12=0.01",
+        "--steps",
+        "20",
+        "--unload",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("curve.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 61, "header + load, unload, reload");
+    let switches = std::fs::read_to_string(out.join("switches.csv")).unwrap();
+    assert!(switches.lines().nth(1).unwrap().contains(",stick,slip,"));
+    let svg = std::fs::read_to_string(out.join("curve.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("<polyline") && svg.contains("<circle"));
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("curve.json")).unwrap()).unwrap();
+    assert_eq!(doc["points"].as_array().unwrap().len(), 60);
+    for (args, needle) in [
+        (
+            vec![
+                "curve",
+                "fixtures/ok_cell_contact.toml",
+                "--strain",
+                "e33=0.1",
+            ],
+            "unknown strain component",
+        ),
+        (
+            vec![
+                "curve",
+                "fixtures/ok_cell_contact.toml",
+                "--strain",
+                "e11=nan",
+            ],
+            "not finite",
+        ),
+        (
+            vec!["curve", "fixtures/ok_frame3d.toml", "--strain", "e11=0.01"],
+            "no [cell] section",
+        ),
+    ] {
+        let o = run(&args);
+        assert!(!o.status.success(), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains(needle),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}

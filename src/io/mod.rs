@@ -6,6 +6,7 @@ mod atomic;
 mod error;
 mod matrix_market;
 mod native;
+mod plot;
 mod results;
 mod vtk;
 
@@ -14,6 +15,7 @@ pub use atomic::write_atomic;
 pub use error::InputError;
 pub use matrix_market::write_matrix_market;
 pub use native::{parse_json, parse_toml, to_json, to_toml};
+pub use plot::{line_plot_svg, Series};
 pub use results::{
     contacts_csv, displacements_csv, incremental_json, increments_csv, solution_json,
 };
