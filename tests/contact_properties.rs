@@ -184,3 +184,56 @@ fn open_contacts_contribute_nothing() {
         }
     }
 }
+
+#[test]
+fn a_finely_meshed_fiber_does_not_touch_itself_but_a_folded_one_does() {
+    // A U-shaped fiber: two straight legs 3r apart (surface gap r) joined by a half circle, all
+    // meshed with elements much shorter than the radius.
+    let r = 0.01;
+    let mut d = ModelDescription {
+        materials: vec![material()],
+        ..Default::default()
+    };
+    let mut ids = Vec::new();
+    let mut push = |d: &mut ModelDescription, x: [f64; 3]| {
+        let id = d.nodes.len() as u64 + 1;
+        d.nodes.push(NodeSpec { id, x });
+        ids.push(id);
+    };
+    let (leg, radius_u, h) = (0.2, 1.5 * r, 0.25 * r);
+    let n_leg = (leg / h) as usize;
+    for k in 0..=n_leg {
+        push(&mut d, [leg - k as f64 * h, -radius_u, 0.0]);
+    }
+    for k in 1..20 {
+        let a = -std::f64::consts::FRAC_PI_2 - std::f64::consts::PI * k as f64 / 20.0;
+        push(&mut d, [radius_u * a.cos(), radius_u * a.sin(), 0.0]);
+    }
+    for k in 0..=n_leg {
+        push(&mut d, [k as f64 * h, radius_u, 0.0]);
+    }
+    d.fibers.push(FiberSpec {
+        id: 1,
+        nodes: ids,
+        radius: r,
+        material: "m".into(),
+    });
+    let model = Model::from_description(&d).unwrap();
+    let found = find_candidates(&model, 1.5 * r);
+    assert!(!found.is_empty(), "the two legs face each other");
+    // Every candidate joins the two legs, never neighbours along the fiber.
+    for c in &found {
+        let y = |e: usize, xi: f64| {
+            let el = model.elements()[e];
+            let (p, q) = (model.nodes[el.nodes[0]].x[1], model.nodes[el.nodes[1]].x[1]);
+            p + xi * (q - p)
+        };
+        assert!(
+            y(c.elements[0], c.xi[0]) * y(c.elements[1], c.xi[1]) < 0.0,
+            "{c:?}"
+        );
+    }
+    // The same legs straightened out: no self-contact at all.
+    let straight = fibers(&[([0.0; 3], [1.0, 0.0, 0.0], r)], 400);
+    assert!(find_candidates(&Model::from_description(&straight).unwrap(), r).is_empty());
+}

@@ -3,7 +3,8 @@
 //! then the exact segment–segment narrow phase.
 //!
 //! Excluded pairs: elements sharing a node (joined fibers touch by construction) and elements
-//! of the same fiber fewer than three apart along it (a bent fiber's neighbours). The search works
+//! of the same fiber separated along it by less than π (r_I + r_II) of fiber — closer than that a
+//! fiber cannot fold back onto itself without bending tighter than its own radius. The search works
 //! on the undeformed geometry (small displacements); periodic images will be searched by
 //! shifting the positions of one side (issue 4).
 
@@ -36,24 +37,39 @@ fn element_radii(model: &Model) -> Vec<f64> {
         .collect()
 }
 
-/// Position of every element within its fiber.
-fn positions_in_fiber(model: &Model) -> Vec<usize> {
+/// Arc length along its fiber at the start of every element.
+fn arc_positions(model: &Model) -> Vec<f64> {
     let els = model.elements();
-    let mut pos = vec![0; els.len()];
+    let mut pos = vec![0.0; els.len()];
     for e in 1..els.len() {
         if els[e].fiber == els[e - 1].fiber {
-            pos[e] = pos[e - 1] + 1;
+            let [p, q] = els[e - 1].nodes;
+            let l: f64 = (0..3)
+                .map(|k| (model.nodes[q].x[k] - model.nodes[p].x[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            pos[e] = pos[e - 1] + l;
         }
     }
     pos
 }
 
-fn excluded(model: &Model, pos: &[usize], a: usize, b: usize) -> bool {
+fn excluded(model: &Model, radii: &[f64], arc: &[f64], a: usize, b: usize) -> bool {
     let (ea, eb) = (model.elements()[a], model.elements()[b]);
     if ea.nodes.iter().any(|n| eb.nodes.contains(n)) {
         return true;
     }
-    ea.fiber == eb.fiber && pos[a].abs_diff(pos[b]) < 3
+    if ea.fiber != eb.fiber {
+        return false;
+    }
+    // Fiber between the end of the earlier element and the start of the later one.
+    let (first, second) = if arc[a] <= arc[b] { (a, b) } else { (b, a) };
+    let [p, q] = model.elements()[first].nodes;
+    let len_first: f64 = (0..3)
+        .map(|k| (model.nodes[q].x[k] - model.nodes[p].x[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    arc[second] - (arc[first] + len_first) < std::f64::consts::PI * (radii[a] + radii[b])
 }
 
 /// Narrow phase for one pair: a candidate if the surfaces are within `tolerance`.
@@ -110,7 +126,7 @@ pub fn find_candidates(model: &Model, tolerance: f64) -> Vec<Candidate> {
         return Vec::new();
     }
     let radii = element_radii(model);
-    let pos = positions_in_fiber(model);
+    let arc = arc_positions(model);
     // Inflated boxes: half the tolerance on each side, so boxes of a candidate pair overlap.
     let boxes: Vec<([f64; 3], [f64; 3])> = els
         .iter()
@@ -186,7 +202,7 @@ pub fn find_candidates(model: &Model, tolerance: f64) -> Vec<Candidate> {
                     // intersection, so each pair is tested once.
                     let corner = [0, 1, 2].map(|k| index(boxes[a].0[k].max(boxes[b].0[k]), k));
                     if key(corner[0], corner[1], corner[2]) != cell_key
-                        || excluded(model, &pos, a, b)
+                        || excluded(model, &radii, &arc, a, b)
                     {
                         continue;
                     }
@@ -206,12 +222,12 @@ pub fn find_candidates(model: &Model, tolerance: f64) -> Vec<Candidate> {
 /// The same result by testing all pairs: O(n²), for tests only.
 pub fn find_candidates_brute_force(model: &Model, tolerance: f64) -> Vec<Candidate> {
     let radii = element_radii(model);
-    let pos = positions_in_fiber(model);
+    let arc = arc_positions(model);
     let n = model.elements().len();
     let mut out = Vec::new();
     for a in 0..n {
         for b in a + 1..n {
-            if !excluded(model, &pos, a, b) {
+            if !excluded(model, &radii, &arc, a, b) {
                 if let Some(c) = narrow(model, &radii, a, b, tolerance) {
                     out.push(c);
                 }
