@@ -143,6 +143,23 @@ fn write(path: &Path, contents: &str) -> Result<(), Error> {
     io::write_atomic(path, contents.as_bytes())
 }
 
+/// A progress bar on stderr for runs of many increments (hidden when stderr is not a terminal).
+fn progress_bar(what: &str) -> (indicatif::ProgressBar, fibercell::solve::Progress) {
+    let bar = indicatif::ProgressBar::new(0);
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} increments ({eta})")
+    {
+        bar.set_style(style);
+    }
+    bar.set_message(what.to_string());
+    let b = bar.clone();
+    let report = fibercell::solve::Progress(std::sync::Arc::new(move |done, total| {
+        b.set_length(total as u64);
+        b.set_position(done as u64);
+    }));
+    (bar, report)
+}
+
 fn to_pretty(doc: &serde_json::Value) -> Result<String, Error> {
     serde_json::to_string_pretty(doc).map_err(|e| Error::Output {
         path: "json".into(),
@@ -228,13 +245,17 @@ fn solve_with_contact(
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
+    let (bar, progress) = progress_bar("stick/slip");
     let opts = IncrementalOptions {
         steps,
         solve,
         fixed_slip_direction,
+        progress: Some(progress),
         ..IncrementalOptions::default()
     };
-    let sol = solve_incremental(model, &opts)?;
+    let sol = solve_incremental(model, &opts);
+    bar.finish_and_clear();
+    let sol = sol?;
     let pretty = to_pretty(&io::incremental_json(model, &sol))?;
     let final_u = sol.displacements.last().map(|d| &d[..]).unwrap_or(&[]);
     write(

@@ -411,3 +411,20 @@ fn fixed_slip_direction_variant_of_remark_4_38() {
         }
     }
 }
+
+#[test]
+fn progress_is_reported_after_every_increment() {
+    use std::sync::{Arc, Mutex};
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let log = seen.clone();
+    let m = io::load_model(Path::new("fixtures/ok_contact_bars2.toml")).unwrap();
+    let opts = IncrementalOptions {
+        steps: 3,
+        progress: Some(fibercell::solve::Progress(Arc::new(move |done, total| {
+            log.lock().unwrap().push((done, total))
+        }))),
+        ..Default::default()
+    };
+    solve_incremental(&m, &opts).unwrap();
+    assert_eq!(*seen.lock().unwrap(), vec![(1, 3), (2, 3), (3, 3)]);
+}

@@ -20,6 +20,16 @@ use fibercell_solver::{solve_checked, LinearSolver, SolverError};
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use serde::Serialize;
 
+/// A callback told after every increment: (increments done, increments in all).
+#[derive(Clone)]
+pub struct Progress(pub std::sync::Arc<dyn Fn(usize, usize) + Send + Sync>);
+
+impl std::fmt::Debug for Progress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Progress(callback)")
+    }
+}
+
 /// Options of [`solve_incremental`].
 #[derive(Clone, Debug)]
 pub struct IncrementalOptions {
@@ -36,6 +46,8 @@ pub struct IncrementalOptions {
     /// displacement in a frictionless pre-run, instead of the trial direction of the return
     /// mapping (the default, and the more faithful treatment).
     pub fixed_slip_direction: bool,
+    /// Called after every increment (e.g. to drive a progress bar).
+    pub progress: Option<Progress>,
 }
 
 impl Default for IncrementalOptions {
@@ -46,6 +58,7 @@ impl Default for IncrementalOptions {
             max_state_iterations: 50,
             path: None,
             fixed_slip_direction: false,
+            progress: None,
         }
     }
 }
@@ -752,6 +765,9 @@ pub(crate) fn run_incremental(
         out.contact_results.push(records);
         out.displacements.push(disc.physical(&q));
         out.reactions = reactions;
+        if let Some(p) = &opts.progress {
+            (p.0)(step, path.len());
+        }
     }
     Ok(out)
 }

@@ -11,6 +11,7 @@ pub use connectivity::{check_supported, check_supported_with};
 pub(crate) use incremental::run_incremental;
 pub use incremental::{
     solve_incremental, ContactRecord, IncrementRecord, IncrementalOptions, IncrementalSolution,
+    Progress,
 };
 pub use reduced::ReducedSystem;
 pub use static_solve::{solve_static, SolveOptions, SolveSummary, StaticSolution, Timings};
