@@ -5,7 +5,7 @@
 use super::{Orthotropic, PeriodicSystem, ThesisModuli};
 use crate::cell::CellGeometry;
 use crate::model::Model;
-use crate::solve::{make_solver, SolveOptions};
+use crate::solve::{check_backward_error, locate, make_solver, SolveOptions};
 use crate::Error;
 use fibercell_solver::{solve_checked, SolverError};
 use serde::Serialize;
@@ -52,18 +52,8 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
     let n = sys.n_free();
     let a = sys.pattern.matrix(&vals.values)?;
     let mut solver = make_solver(options.solver, &options.ordering, Vec::new())?;
-    let locate = |e: SolverError| match e {
-        SolverError::NotPositiveDefinite { column, pivot } if column < n => {
-            let (node, dof) = sys.node_dof(column);
-            Error::Singular {
-                node: model.nodes[node].id,
-                dof,
-                fibers: model.fibers_at_node(node),
-                pivot,
-            }
-        }
-        other => Error::Solver(other),
-    };
+    let node_dof = |c: usize| (c < n).then(|| sys.node_dof(c));
+    let locate = |e: SolverError| locate(e, model, &node_dof);
     solver.analyze(a).map_err(locate)?;
     solver.factorize(a).map_err(locate)?;
     let mut rhs = vec![0.0; 6 * n];
@@ -73,20 +63,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
         }
     }
     let (x, report) = solve_checked(solver.as_mut(), a, &rhs, 6).map_err(locate)?;
-    let max_bwd = if options.max_backward_error > 0.0 {
-        options.max_backward_error
-    } else {
-        1e-10
-    };
-    if !(report.backward_error <= max_bwd) {
-        return Err(Error::Solver(SolverError::Singular {
-            column: None,
-            detail: format!(
-                "cell problems: backward error {:.3e} exceeds {max_bwd:.1e}",
-                report.backward_error
-            ),
-        }));
-    }
+    check_backward_error(options, report.backward_error, "cell problems")?;
     let g = sys.periodicity.geometry;
     let area = g.area();
     let mut abd = [[0.0; 6]; 6];

@@ -10,6 +10,7 @@
 //! Coulomb-sliding contact are nonsymmetric and go to LU, all others to the chosen symmetric
 //! backend.
 
+use super::static_solve::{check_backward_error, locate};
 use super::{check_supported_with, make_solver, SolveOptions, SolverKind};
 use crate::assembly::{element_stiffness, Assembler, DofMap, Pattern, NO_SLOT};
 use crate::constraints::{internal_forces, Discretization, Reaction};
@@ -478,25 +479,8 @@ pub(crate) fn run_incremental(
         symmetric: None,
         general: None,
     };
-    let max_bwd = if opts.solve.max_backward_error > 0.0 {
-        opts.solve.max_backward_error
-    } else {
-        1e-10
-    };
-    let locate = |e: SolverError| match e {
-        SolverError::NotPositiveDefinite { column, pivot }
-            if column < n_free && disc.node_dof(column).0 < model.nodes.len() =>
-        {
-            let (node, dof) = disc.node_dof(column);
-            Error::Singular {
-                node: model.nodes[node].id,
-                dof,
-                fibers: model.fibers_at_node(node),
-                pivot,
-            }
-        }
-        other => Error::Solver(other),
-    };
+    let node_dof = |c: usize| (c < n_free).then(|| disc.node_dof(c));
+    let locate = |e: SolverError| locate(e, model, &node_dof);
 
     // Contact states: closed pairs start in stick (thesis step 1), others open.
     let initial = |p: &ContactPair| {
@@ -626,14 +610,7 @@ pub(crate) fn run_incremental(
                 (x, Some(r))
             };
             let bwd = report.as_ref().map_or(0.0, |r| r.backward_error);
-            if !(bwd <= max_bwd) {
-                return Err(Error::Solver(SolverError::Singular {
-                    column: None,
-                    detail: format!(
-                        "increment {step}: backward error {bwd:.3e} exceeds {max_bwd:.1e}"
-                    ),
-                }));
-            }
+            check_backward_error(&opts.solve, bwd, &format!("increment {step}"))?;
             q = disc.generalized(&x, alpha);
             // Return mapping of every contact.
             let trials: Vec<Trial> = pairs

@@ -14,4 +14,5 @@ pub use incremental::{
     Progress,
 };
 pub use reduced::ReducedSystem;
+pub(crate) use static_solve::{check_backward_error, locate};
 pub use static_solve::{solve_static, SolveOptions, SolveSummary, StaticSolution, Timings};

@@ -3,7 +3,7 @@
 use super::{check_supported, make_solver, ReducedSystem, SolverKind};
 use crate::assembly::FillMode;
 use crate::constraints::{reactions, Reaction};
-use crate::model::Model;
+use crate::model::{Dof, Model};
 use crate::Error;
 use fibercell_solver::{solve_checked, Ordering, SolverError};
 use serde::Serialize;
@@ -77,20 +77,47 @@ pub struct StaticSolution {
     pub summary: SolveSummary,
 }
 
-/// Maps a pivot failure at a reduced column to the node, DOF and fibers.
-pub(super) fn locate(e: SolverError, model: &Model, dofs: &crate::assembly::DofMap) -> Error {
+/// Maps a pivot failure at a reduced column to the node, DOF and fibers; `node_dof` gives the
+/// (node, DOF) of a column, `None` when it is not a physical node's DOF.
+pub(crate) fn locate(
+    e: SolverError,
+    model: &Model,
+    node_dof: &dyn Fn(usize) -> Option<(usize, Dof)>,
+) -> Error {
     match e {
-        SolverError::NotPositiveDefinite { column, pivot } if column < dofs.n_free() => {
-            let (node, dof) = dofs.node_dof(column);
-            Error::Singular {
-                node: model.nodes[node].id,
-                dof,
-                fibers: model.fibers_at_node(node),
-                pivot,
+        SolverError::NotPositiveDefinite { column, pivot } => {
+            match node_dof(column).filter(|(n, _)| *n < model.nodes.len()) {
+                Some((node, dof)) => Error::Singular {
+                    node: model.nodes[node].id,
+                    dof,
+                    fibers: model.fibers_at_node(node),
+                    pivot,
+                },
+                None => Error::Solver(SolverError::NotPositiveDefinite { column, pivot }),
             }
         }
         other => Error::Solver(other),
     }
+}
+
+/// Rejects a solve whose backward error exceeds `options.max_backward_error` (1e-10 when 0).
+pub(crate) fn check_backward_error(
+    options: &SolveOptions,
+    backward_error: f64,
+    context: &str,
+) -> Result<(), Error> {
+    let tol = if options.max_backward_error > 0.0 {
+        options.max_backward_error
+    } else {
+        1e-10
+    };
+    if backward_error <= tol {
+        return Ok(());
+    }
+    Err(Error::Solver(SolverError::Singular {
+        column: None,
+        detail: format!("{context}: backward error {backward_error:.3e} exceeds {tol:.1e}: the solution cannot be trusted"),
+    }))
 }
 
 /// Solves K u = F for the supports and loads of `model`.
@@ -110,6 +137,7 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
         nnz: sys.pattern.nnz(),
         ..SolveSummary::default()
     };
+    let node_dof = |c: usize| (c < n).then(|| sys.dofs.node_dof(c));
     let reduced = if n == 0 {
         Vec::new()
     } else {
@@ -120,16 +148,16 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
             sys.dofs.node_block_starts(),
         )?;
         let t = Instant::now();
-        let info = solver.analyze(a).map_err(|e| locate(e, model, &sys.dofs))?;
+        let info = solver.analyze(a).map_err(|e| locate(e, model, &node_dof))?;
         timings.analyze = t.elapsed().as_secs_f64();
         let t = Instant::now();
         solver
             .factorize(a)
-            .map_err(|e| locate(e, model, &sys.dofs))?;
+            .map_err(|e| locate(e, model, &node_dof))?;
         timings.factorize = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let (mut x, mut report) = solve_checked(solver.as_mut(), a, &sys.rhs, 1)
-            .map_err(|e| locate(e, model, &sys.dofs))?;
+            .map_err(|e| locate(e, model, &node_dof))?;
         // Iterative refinement with the same factor: x += A⁻¹(b − A x), while it helps.
         for _ in 0..2 {
             if report.relative_residual <= 1e-13 || report.info.iterations.is_some() {
@@ -141,7 +169,7 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
                 .zip(&sys.rhs)
                 .for_each(|(ri, bi)| *ri = bi - *ri);
             let (dx, _) = solve_checked(solver.as_mut(), a, &r, 1)
-                .map_err(|e| locate(e, model, &sys.dofs))?;
+                .map_err(|e| locate(e, model, &node_dof))?;
             let refined: Vec<f64> = x.iter().zip(&dx).map(|(p, q)| p + q).collect();
             let res = fibercell_solver::relative_residual(a, &refined, &sys.rhs);
             if !(res < report.relative_residual) {
@@ -152,20 +180,11 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
             report.backward_error = fibercell_solver::backward_error(a, &x, &sys.rhs);
         }
         timings.solve = t.elapsed().as_secs_f64();
-        let tol = if options.max_backward_error > 0.0 {
-            options.max_backward_error
-        } else {
-            1e-10
-        };
-        if !(report.backward_error <= tol) {
-            return Err(Error::Solver(SolverError::Singular {
-                column: None,
-                detail: format!(
-                    "backward error {:.3e} exceeds {tol:.1e} (relative residual {:.3e}): the solution cannot be trusted",
-                    report.backward_error, report.relative_residual
-                ),
-            }));
-        }
+        check_backward_error(
+            options,
+            report.backward_error,
+            &format!("relative residual {:.3e}", report.relative_residual),
+        )?;
         summary.ordering = info.ordering;
         summary.nnz_factor = info.nnz_factor;
         summary.flops = info.flops;
