@@ -25,7 +25,7 @@ pub enum ContactSide {
     },
 }
 
-/// [u] = u_I − u_II = B q over `nodes` (DOFs node by node, 6 each; columns beyond 6·len are 0).
+/// \[u\] = u_I − u_II = B q over `nodes` (DOFs node by node, 6 each; columns beyond 6·len are 0).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Jump {
     /// Distinct node indices of the block.

@@ -111,7 +111,7 @@ pub enum ModelError {
     /// Invalid contact settings or explicit contact pair.
     #[error("{item}: {message}")]
     InvalidContact {
-        /// "[contact]" or "contact pair 3".
+        /// "\[contact\]" or "contact pair 3".
         item: String,
         /// What is wrong.
         message: String,

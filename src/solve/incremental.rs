@@ -103,7 +103,7 @@ pub struct ContactRecord {
     /// open, stick or slip.
     #[serde(serialize_with = "state_name")]
     pub state: ContactState,
-    /// Current gap ḡ − nᵀ[u] (m; negative: penetration, which the penalty allows).
+    /// Current gap ḡ − nᵀ\[u\] (m; negative: penetration, which the penalty allows).
     pub gap: f64,
     /// Normal force N ≥ 0 (N).
     pub normal_force: f64,

@@ -12,7 +12,7 @@ pub struct BlockJacobi {
 }
 
 impl BlockJacobi {
-    /// Factorizes the diagonal blocks [starts[k], starts[k+1]) of `a`.
+    /// Factorizes the diagonal blocks `starts[k]..starts[k + 1]` of `a`.
     pub fn new(a: CscRef<'_>, starts: &[usize]) -> Result<Self, SolverError> {
         let n = a.ncols();
         let mut factors = Vec::new();
