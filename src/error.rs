@@ -63,7 +63,8 @@ pub enum Error {
     },
 }
 
-fn list(ids: &[u64]) -> String {
+/// Up to 20 ids, comma separated, then the total.
+pub(crate) fn list(ids: &[u64]) -> String {
     let mut s: Vec<String> = ids.iter().take(20).map(|i| i.to_string()).collect();
     if ids.len() > 20 {
         s.push(format!("… ({} in all)", ids.len()));

@@ -83,15 +83,7 @@ impl DofMap {
     /// First reduced index of every node that has free DOFs (node blocks for block
     /// preconditioners).
     pub fn node_block_starts(&self) -> Vec<usize> {
-        let mut starts = Vec::new();
-        let mut last_node = usize::MAX;
-        for (r, &g) in self.free.iter().enumerate() {
-            if g / 6 != last_node {
-                starts.push(r);
-                last_node = g / 6;
-            }
-        }
-        starts
+        block_starts(self.free.iter().map(|&g| g / 6))
     }
     /// Expands a reduced solution to all global DOFs, filling in prescribed values.
     pub fn expand(&self, reduced: &[f64]) -> Vec<f64> {
@@ -102,4 +94,18 @@ impl DofMap {
             })
             .collect()
     }
+}
+
+/// Positions where the node of consecutive unknowns changes: the first unknown of every node
+/// block (block-Jacobi preconditioner blocks).
+pub fn block_starts(nodes: impl Iterator<Item = usize>) -> Vec<usize> {
+    let mut starts = Vec::new();
+    let mut last = usize::MAX;
+    for (k, node) in nodes.enumerate() {
+        if node != last {
+            starts.push(k);
+            last = node;
+        }
+    }
+    starts
 }

@@ -7,6 +7,6 @@ mod fill;
 mod pattern;
 
 pub use coloring::color_elements;
-pub use dof_map::DofMap;
+pub use dof_map::{block_starts, DofMap};
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
 pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};

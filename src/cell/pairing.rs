@@ -1,5 +1,6 @@
 //! Pairing of boundary nodes across opposite faces of the periodic cell.
 
+use crate::error::list;
 use crate::model::Model;
 use std::collections::HashMap;
 
@@ -61,14 +62,6 @@ fn plural<T>(v: &[T]) -> &'static str {
     } else {
         "s"
     }
-}
-
-fn list(ids: &[u64]) -> String {
-    let mut s: Vec<String> = ids.iter().take(20).map(|i| i.to_string()).collect();
-    if ids.len() > 20 {
-        s.push(format!("… ({} in all)", ids.len()));
-    }
-    s.join(", ")
 }
 
 /// Box, mid-surface, thickness and pairing tolerance of a cell.

@@ -128,15 +128,7 @@ impl Discretization {
     }
     /// First unknown of every generalized node that has unknowns (block-Jacobi blocks).
     pub fn node_block_starts(&self) -> Vec<usize> {
-        let mut starts = Vec::new();
-        let mut last = usize::MAX;
-        for (k, &(node, _)) in self.free.iter().enumerate() {
-            if node != last {
-                starts.push(k);
-                last = node;
-            }
-        }
-        starts
+        crate::assembly::block_starts(self.free.iter().map(|&(node, _)| node))
     }
 
     /// The generalized nodes of a block of physical nodes and T (6·nodes × 6·gnodes) with

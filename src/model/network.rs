@@ -121,6 +121,19 @@ fn check_material(m: &super::MaterialSpec) -> Result<Material, ModelError> {
     })
 }
 
+/// Diagonal of the bounding box of `nodes`.
+fn bounding_diagonal(nodes: &[Node]) -> f64 {
+    let (lo, hi) = nodes
+        .iter()
+        .fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), n| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(n.x[k])),
+                [0, 1, 2].map(|k| hi[k].max(n.x[k])),
+            )
+        });
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+}
+
 fn check_cell(c: &super::CellSpec) -> Result<(), ModelError> {
     let bad = |what: &str, v: f64| {
         ModelError::InvalidCell(format!("{what} = {v} must be finite and > 0"))
@@ -191,17 +204,7 @@ impl Model {
                 })
         };
         // Length scale for "zero length": the bounding box diagonal.
-        let (lo, hi) = nodes
-            .iter()
-            .fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), n| {
-                (
-                    [lo[0].min(n.x[0]), lo[1].min(n.x[1]), lo[2].min(n.x[2])],
-                    [hi[0].max(n.x[0]), hi[1].max(n.x[1]), hi[2].max(n.x[2])],
-                )
-            });
-        let diag =
-            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
-        let min_length = 1e-12 * diag.max(f64::MIN_POSITIVE);
+        let min_length = 1e-12 * bounding_diagonal(&nodes).max(f64::MIN_POSITIVE);
 
         let mut fibers = Vec::with_capacity(d.fibers.len());
         let mut fiber_ids = HashMap::new();
@@ -490,6 +493,11 @@ impl Model {
             contacts: self.contact_specs.1.clone(),
             cell: self.cell.clone(),
         }
+    }
+
+    /// Diagonal of the bounding box of the nodes (m): the model's length scale.
+    pub fn size(&self) -> f64 {
+        bounding_diagonal(&self.nodes)
     }
 
     /// Whether the model has contact (settings present).

@@ -242,20 +242,6 @@ fn describe(model: &Model, set: &ContactSet, i: usize) -> String {
     )
 }
 
-/// Diagonal of the model's bounding box.
-fn model_size(model: &Model) -> f64 {
-    let (lo, hi) = model
-        .nodes
-        .iter()
-        .fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), n| {
-            (
-                [0, 1, 2].map(|k| lo[k].min(n.x[k])),
-                [0, 1, 2].map(|k| hi[k].max(n.x[k])),
-            )
-        });
-    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
-}
-
 /// What an assembled matrix was built from: symmetry, states, slip directions, k⊥ of each contact.
 type AssembledKey = (bool, Vec<ContactState>, Vec<Vector2<f64>>, Vec<f64>);
 
@@ -374,7 +360,7 @@ impl Elastic {
     }
 
     /// Generalized internal forces K q for the full generalized vector q.
-    fn internal(&self, model: &Model, disc: &Discretization, q: &[f64]) -> Vec<f64> {
+    fn internal(&self, model: &Model, q: &[f64]) -> Vec<f64> {
         if self.maps.iter().all(|m| m.is_none()) {
             return internal_forces(model, &q[..6 * model.nodes.len()]);
         }
@@ -388,7 +374,6 @@ impl Elastic {
                 out[6 * gnodes[r / 6] + r % 6] += v;
             }
         }
-        let _ = disc;
         out
     }
 }
@@ -502,7 +487,7 @@ pub(crate) fn run_incremental(
     // What the current factorization was built from (None: nothing factorized yet).
     let mut factorized: Option<AssembledKey> = None;
 
-    let length_tol = 1e-12 * model_size(model);
+    let length_tol = 1e-12 * model.size();
     let mut values = k_elastic.clone();
     let mut q = vec![0.0; 6 * disc.n_gnodes()];
     let mut out = IncrementalSolution {
@@ -668,7 +653,7 @@ pub(crate) fn run_incremental(
         };
         // Commit the slip history and record the increment.
         let mut records = Vec::with_capacity(pairs.len());
-        let mut forces = elastic.internal(model, disc, &q);
+        let mut forces = elastic.internal(model, &q);
         for (i, (pair, t)) in pairs.iter().zip(&trials).enumerate() {
             match t.state {
                 ContactState::Open => slips[i] = t.relative,

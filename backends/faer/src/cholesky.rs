@@ -223,7 +223,7 @@ impl LinearSolver for FaerCholesky {
             } else {
                 index
             };
-            an.perm.fwd[k.min(n - 1)]
+            an.perm.fwd[k.min(n.saturating_sub(1))]
         };
         match self.variant {
             CholeskyVariant::Llt => {
