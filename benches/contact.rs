@@ -15,12 +15,12 @@ fn contact(c: &mut Criterion) {
         let model = Model::from_description(&crossing_grid(k, 4, 5e-3, 2e-4)).expect("grid");
         let segments = model.elements().len();
         let tolerance = model.contact.as_ref().map_or(0.0, |s| s.tolerance);
-        let found = find_candidates(&model, tolerance).len();
+        let found = find_candidates(&model, tolerance, None).len();
         let pairs = ContactSet::build(&model).expect("contacts").pairs.len();
         eprintln!("crossing grid {k}×{k}: {segments} segments, {found} candidate element pairs, {pairs} contacts");
         g.throughput(Throughput::Elements(segments as u64));
         g.bench_function(format!("search/{segments}-segments"), |b| {
-            b.iter(|| black_box(find_candidates(black_box(&model), tolerance).len()))
+            b.iter(|| black_box(find_candidates(black_box(&model), tolerance, None).len()))
         });
     }
     let model = Model::from_description(&crossing_grid(20, 4, 5e-3, 2e-4)).expect("grid");

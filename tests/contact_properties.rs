@@ -1,10 +1,12 @@
 //! Properties of the contact formulation and search (proptest): K_N and K_T^st symmetric
 //! positive semi-definite, only K_T^sl nonsymmetric, open contacts inert, penetration ∝ 1/penalty,
-//! and the grid search equal to the all-pairs search.
+//! the rolling block symmetric positive semi-definite, and the grid search (with and without
+//! periodic images) equal to the all-pairs search.
 
+use fibercell::cell::{CellGeometry, Periodicity};
 use fibercell::contact::{
-    find_candidates, find_candidates_brute_force, jump_operator, tangent_basis, ContactPair,
-    ContactSide, Friction,
+    closest_points, find_candidates, find_candidates_brute_force, jump_operator, tangent_basis,
+    ContactPair, ContactSide, Friction,
 };
 use fibercell::model::{FiberSpec, MaterialSpec, ModelDescription, NodeSpec};
 use fibercell::solve::{solve_incremental, solve_static, IncrementalOptions, SolveOptions};
@@ -66,7 +68,7 @@ fn pair_from(model: &Model, xi: [f64; 2], normal: Vector3<f64>) -> ContactPair {
             xi: xi[1],
         },
     ];
-    let jump = jump_operator(model, sides[0], sides[1]).expect("disjoint");
+    let jump = jump_operator(model, sides[0], sides[1], [0, 0]).expect("disjoint");
     ContactPair {
         jump,
         tangents: tangent_basis(&normal, &Vector3::new(1.0, 0.2, -0.1)),
@@ -74,6 +76,7 @@ fn pair_from(model: &Model, xi: [f64; 2], normal: Vector3<f64>) -> ContactPair {
         gap: 1e-4,
         penalty_normal: 3e5,
         penalty_tangent: 1e5,
+        penalty_rotation: 2e-2,
     }
 }
 
@@ -100,7 +103,7 @@ proptest! {
         let pair = pair_from(&model, xi, normal);
         let (kn, _) = pair.normal();
         let (kt, _) = pair.stick(&Vector2::new(1e-5, -2e-5));
-        for k in [kn, kt] {
+        for k in [kn, kt, pair.rotation()] {
             let m = block(&pair, &k);
             let scale = m.amax();
             prop_assert!((&m - m.transpose()).amax() <= 1e-12 * scale);
@@ -125,13 +128,56 @@ proptest! {
         let lines: Vec<_> = lines.into_iter().filter(|(a, b, _)| (Vector3::from(*b) - Vector3::from(*a)).norm() > 0.05).collect();
         prop_assume!(lines.len() >= 2);
         let model = Model::from_description(&fibers(&lines, sub)).unwrap();
-        let fast = find_candidates(&model, tolerance);
-        let mut slow = find_candidates_brute_force(&model, tolerance);
-        slow.sort_by_key(|c| c.elements);
+        let fast = find_candidates(&model, tolerance, None);
+        let slow = find_candidates_brute_force(&model, tolerance, None);
         prop_assert_eq!(fast.len(), slow.len());
         for (x, y) in fast.iter().zip(&slow) {
             prop_assert_eq!(x.elements, y.elements);
             prop_assert!((x.distance - y.distance).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn grid_search_with_periodic_images_finds_exactly_the_all_images_candidates(
+        lines in prop::collection::vec((point(), point(), 0.005f64..0.05), 2..10),
+        sub in 1usize..4,
+        tolerance in 0.0f64..0.05,
+        period in prop::array::uniform2(0.6f64..2.5),
+    ) {
+        let lines: Vec<_> = lines.into_iter().filter(|(a, b, _)| (Vector3::from(*b) - Vector3::from(*a)).norm() > 0.05).collect();
+        prop_assume!(lines.len() >= 2);
+        let model = Model::from_description(&fibers(&lines, sub)).unwrap();
+        // Every node independent: only the images differ from the plain search.
+        let cell = Periodicity {
+            geometry: CellGeometry {
+                origin: [-1.0, -1.0],
+                size: period,
+                z_mid: 0.0,
+                thickness: 1.0,
+                tolerance: 1e-9,
+            },
+            master: vec![None; model.nodes.len()],
+        };
+        let fast = find_candidates(&model, tolerance, Some(&cell));
+        let slow = find_candidates_brute_force(&model, tolerance, Some(&cell));
+        prop_assert_eq!(fast.len(), slow.len());
+        for (x, y) in fast.iter().zip(&slow) {
+            prop_assert_eq!((x.elements, x.shift), (y.elements, y.shift));
+            prop_assert!((x.distance - y.distance).abs() < 1e-14);
+        }
+        // Every shifted candidate really is that close: distance between the element and
+        // the shifted image.
+        for c in fast.iter().filter(|c| c.shift != [0, 0]) {
+            let seg = |e: usize, s: [i32; 2]| {
+                let el = model.elements()[e];
+                el.nodes.map(|n| {
+                    let x = model.nodes[n].x;
+                    [x[0] + f64::from(s[0]) * period[0], x[1] + f64::from(s[1]) * period[1], x[2]]
+                })
+            };
+            let (a, b) = (seg(c.elements[0], [0, 0]), seg(c.elements[1], c.shift));
+            let d = closest_points(&a[0], &a[1], &b[0], &b[1]).distance;
+            prop_assert!((d - c.distance).abs() < 1e-12);
         }
     }
 
@@ -219,7 +265,7 @@ fn a_finely_meshed_fiber_does_not_touch_itself_but_a_folded_one_does() {
         material: "m".into(),
     });
     let model = Model::from_description(&d).unwrap();
-    let found = find_candidates(&model, 1.5 * r);
+    let found = find_candidates(&model, 1.5 * r, None);
     assert!(!found.is_empty(), "the two legs face each other");
     // Every candidate joins the two legs, never neighbours along the fiber.
     for c in &found {
@@ -235,5 +281,5 @@ fn a_finely_meshed_fiber_does_not_touch_itself_but_a_folded_one_does() {
     }
     // The same legs straightened out: no self-contact at all.
     let straight = fibers(&[([0.0; 3], [1.0, 0.0, 0.0], r)], 400);
-    assert!(find_candidates(&Model::from_description(&straight).unwrap(), r).is_empty());
+    assert!(find_candidates(&Model::from_description(&straight).unwrap(), r, None).is_empty());
 }

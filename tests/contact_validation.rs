@@ -235,6 +235,8 @@ value = {delta}
 search = false
 penalty_normal = 1.0e5
 penalty_tangent = 2.0e4
+# A point contact, as in the closed form: no rolling resistance.
+penalty_rotation = 0.0
 initial_penetration = "resolve"
 friction = {friction}
 [[contacts]]

@@ -97,6 +97,7 @@ fn cell(bound: f64) -> ModelDescription {
         gap: 0.0,
         penalty_normal: None,
         penalty_tangent: None,
+        penalty_rotation: None,
     }];
     d
 }

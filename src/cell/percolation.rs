@@ -16,11 +16,12 @@ fn find(parent: &mut [usize], offset: &mut [[i32; 2]], i: usize) -> (usize, [i32
 }
 
 /// Checks that every fiber is connected to the others and that chains of fibers cross the cell
-/// in x and in y. `links` are extra node pairs joined inside the cell (the closed contacts).
+/// in x and in y. `links` are extra node pairs joined inside the cell (the contacts), each with
+/// the period shift of the second node's image.
 pub fn check_percolation(
     model: &Model,
     p: &Periodicity,
-    links: &[[usize; 2]],
+    links: &[([usize; 2], [i32; 2])],
 ) -> Result<(), CellError> {
     let n = model.nodes.len();
     let mut parent: Vec<usize> = (0..n).collect();
@@ -30,11 +31,12 @@ pub fn check_percolation(
     let edges = model
         .elements()
         .iter()
-        .map(|e| e.nodes)
+        .map(|e| (e.nodes, [0, 0]))
         .chain(links.iter().copied());
-    for [na, nb] in edges {
+    for ([na, nb], image) in edges {
         let (a, sa) = resolve(na);
         let (b, sb) = resolve(nb);
+        let sb = [sb[0] + image[0], sb[1] + image[1]];
         // Node b's image sits at offset sb − sa from node a's image.
         let want = [sb[0] - sa[0], sb[1] - sa[1]];
         let (ra, oa) = find(&mut parent, &mut offset, a);

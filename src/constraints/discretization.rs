@@ -24,6 +24,9 @@ pub struct Discretization {
     free: Vec<(usize, Dof)>,
     /// Per physical node: the generalized nodes it depends on, with 6×6 blocks (None: itself).
     maps: Vec<Option<Vec<(usize, Matrix6)>>>,
+    /// A periodic cell's periods and every node's position relative to its origin and
+    /// mid-surface (for the images of nodes shifted by whole periods).
+    cell: Option<([f64; 2], Vec<[f64; 3]>)>,
 }
 
 impl Discretization {
@@ -37,7 +40,7 @@ impl Discretization {
             fixed[g] = true;
             prescribed[g] = s.value;
         }
-        Self::number(n, n, fixed, prescribed, vec![None; n])
+        Self::number(n, n, fixed, prescribed, vec![None; n], None)
     }
 
     /// A periodic cell driven by the macroscopic strain `target` (reached at α = 1); the
@@ -64,7 +67,8 @@ impl Discretization {
             fixed[6 * n + k] = true;
             prescribed[6 * n + k] = target[k];
         }
-        Self::number(n, n + 1, fixed, prescribed, maps)
+        let relative = model.nodes.iter().map(|p| g.relative(&p.x)).collect();
+        Self::number(n, n + 1, fixed, prescribed, maps, Some((g.size, relative)))
     }
 
     fn number(
@@ -73,6 +77,7 @@ impl Discretization {
         fixed: Vec<bool>,
         prescribed: Vec<f64>,
         maps: Vec<Option<Vec<(usize, Matrix6)>>>,
+        cell: Option<([f64; 2], Vec<[f64; 3]>)>,
     ) -> Self {
         let mut reduced = vec![usize::MAX; 6 * n_gnodes];
         let mut free = Vec::new();
@@ -91,6 +96,7 @@ impl Discretization {
             prescribed,
             free,
             maps,
+            cell,
         }
     }
 
@@ -134,13 +140,39 @@ impl Discretization {
     /// The generalized nodes of a block of physical nodes and T (6·nodes × 6·gnodes) with
     /// q_physical = T q_generalized.
     pub fn block(&self, nodes: &[usize]) -> (Vec<usize>, DMatrix<f64>) {
+        self.block_of_images(nodes, &vec![[0, 0]; nodes.len()])
+    }
+
+    /// As [`Discretization::block`] for periodic images of the nodes, shifted by `shifts`
+    /// periods: the image of x moves by u(x) + (M(x + sL) − M(x)) E.
+    ///
+    /// # Panics
+    /// If a shift is non-zero outside a periodic cell (a contact set searched with images
+    /// belongs to the cell's discretization).
+    pub fn block_of_images(
+        &self,
+        nodes: &[usize],
+        shifts: &[[i32; 2]],
+    ) -> (Vec<usize>, DMatrix<f64>) {
         let mut gnodes: Vec<usize> = Vec::with_capacity(nodes.len() + 1);
         let mut parts: Vec<(usize, usize, Matrix6)> = Vec::new();
-        for (k, &n) in nodes.iter().enumerate() {
-            let deps: Vec<(usize, Matrix6)> = match &self.maps[n] {
+        for (k, (&n, &s)) in nodes.iter().zip(shifts).enumerate() {
+            let mut deps: Vec<(usize, Matrix6)> = match &self.maps[n] {
                 None => vec![(n, Matrix6::identity())],
                 Some(v) => v.clone(),
             };
+            if s != [0, 0] {
+                let Some((size, relative)) = &self.cell else {
+                    panic!("a periodic image outside a periodic cell");
+                };
+                let x = relative[n];
+                let shifted = macro_matrix(
+                    x[0] + f64::from(s[0]) * size[0],
+                    x[1] + f64::from(s[1]) * size[1],
+                    x[2],
+                );
+                deps.push((self.n_nodes, shifted - macro_matrix(x[0], x[1], x[2])));
+            }
             for (gn, m) in deps {
                 let c = match gnodes.iter().position(|&x| x == gn) {
                     Some(c) => c,
@@ -193,20 +225,28 @@ impl Discretization {
             .collect()
     }
 
-    /// A contact pair with its jump moved onto generalized nodes (B T).
+    /// A contact pair with its jumps moved onto generalized nodes (B T and R T).
     pub fn contact_pair(&self, pair: &ContactPair) -> ContactPair {
-        if self.is_identity() {
+        let images = pair.jump.shifts.iter().any(|s| *s != [0, 0]);
+        if self.is_identity() && !images {
             return pair.clone();
         }
         let k = pair.jump.nodes.len();
-        let (gnodes, t) = self.block(&pair.jump.nodes);
-        let b = DMatrix::from_fn(3, 6 * k, |r, c| pair.jump.b[(r, c)]) * t;
-        let mut padded = JumpMatrix::zeros();
-        padded.view_mut((0, 0), (3, b.ncols())).copy_from(&b);
+        let (gnodes, t) = self.block_of_images(&pair.jump.nodes, &pair.jump.shifts);
+        let moved = |m: &JumpMatrix| {
+            let product = DMatrix::from_fn(3, 6 * k, |r, c| m[(r, c)]) * &t;
+            let mut padded = JumpMatrix::zeros();
+            padded
+                .view_mut((0, 0), (3, product.ncols()))
+                .copy_from(&product);
+            padded
+        };
         ContactPair {
             jump: Jump {
+                shifts: vec![[0, 0]; gnodes.len()],
                 nodes: gnodes,
-                b: padded,
+                b: moved(&pair.jump.b),
+                r: moved(&pair.jump.r),
             },
             ..pair.clone()
         }

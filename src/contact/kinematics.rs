@@ -2,6 +2,12 @@
 //! an element is interpolated with the element's own shape functions — linear for the axial
 //! part, Hermite cubics for the transverse parts — and the jump [u] = u_I − u_II between the two
 //! contact points is a linear map B of the DOFs of the nodes involved.
+//!
+//! Beyond the thesis, the relative rotation [θ] = θ_I − θ_II of the two sides is a second map R
+//! (nodal rotations interpolated linearly along an element), used by the rolling resistance of a
+//! closed contact (see [`ContactPair::rotation`](super::ContactPair::rotation)). In a periodic cell
+//! a side may belong to a periodic image of its element: every node of the block then carries the
+//! number of periods its image is shifted by.
 
 use crate::element::{hermite, linear, local_frame};
 use crate::model::Model;
@@ -25,13 +31,18 @@ pub enum ContactSide {
     },
 }
 
-/// \[u\] = u_I − u_II = B q over `nodes` (DOFs node by node, 6 each; columns beyond 6·len are 0).
+/// \[u\] = u_I − u_II = B q and \[θ\] = θ_I − θ_II = R q over `nodes` (DOFs node by node, 6
+/// each; columns beyond 6·len are 0).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Jump {
-    /// Distinct node indices of the block.
+    /// Node indices of the block (distinct as (node, shift)).
     pub nodes: Vec<usize>,
-    /// The 3 × 6k jump operator, padded to 30 columns.
+    /// Periods (i, j) by which each node's image is shifted (all zero outside periodic cells).
+    pub shifts: Vec<[i32; 2]>,
+    /// The 3 × 6k displacement jump operator, padded to 30 columns.
     pub b: JumpMatrix,
+    /// The 3 × 6k rotation jump operator, padded to 30 columns.
+    pub r: JumpMatrix,
 }
 
 /// The 3×12 map from the element's global DOFs to the global displacement of its centerline at
@@ -62,10 +73,22 @@ pub fn centerline_interpolation(p1: &[f64; 3], p2: &[f64; 3], xi: f64) -> SMatri
     out
 }
 
-/// The part of a side: its nodes and their 3 × 6 blocks.
-fn side_blocks(model: &Model, side: ContactSide) -> Vec<(usize, SMatrix<f64, 3, 6>)> {
+/// A node of a side with its 3 × 6 displacement and rotation blocks.
+type SideBlock = (usize, SMatrix<f64, 3, 6>, SMatrix<f64, 3, 6>);
+
+/// The rotation block of weight w: [0 | w I].
+fn rotation_block(w: f64) -> SMatrix<f64, 3, 6> {
+    let mut m = SMatrix::<f64, 3, 6>::zeros();
+    for d in 0..3 {
+        m[(d, 3 + d)] = w;
+    }
+    m
+}
+
+/// The part of a side: its nodes and their blocks.
+fn side_blocks(model: &Model, side: ContactSide) -> Vec<SideBlock> {
     match side {
-        ContactSide::Node(n) => vec![(n, SMatrix::<f64, 3, 6>::identity())],
+        ContactSide::Node(n) => vec![(n, SMatrix::<f64, 3, 6>::identity(), rotation_block(1.0))],
         ContactSide::Point { element, xi } => {
             let e = model.elements()[element];
             let a = centerline_interpolation(
@@ -74,35 +97,56 @@ fn side_blocks(model: &Model, side: ContactSide) -> Vec<(usize, SMatrix<f64, 3, 
                 xi,
             );
             vec![
-                (e.nodes[0], a.fixed_view::<3, 6>(0, 0).into_owned()),
-                (e.nodes[1], a.fixed_view::<3, 6>(0, 6).into_owned()),
+                (
+                    e.nodes[0],
+                    a.fixed_view::<3, 6>(0, 0).into_owned(),
+                    rotation_block(1.0 - xi),
+                ),
+                (
+                    e.nodes[1],
+                    a.fixed_view::<3, 6>(0, 6).into_owned(),
+                    rotation_block(xi),
+                ),
             ]
         }
     }
 }
 
-/// The jump operator of a contact between two sides; `None` if they share a node (a contact of
-/// a node with itself is meaningless).
-pub fn jump_operator(model: &Model, a: ContactSide, b: ContactSide) -> Option<Jump> {
+/// The jump operators of a contact between side `a` and side `b`, whose element image is
+/// shifted by `shift` periods (\[0, 0\] outside periodic cells); `None` if the two sides share
+/// a node of the same image (a contact of a node with itself is meaningless).
+pub fn jump_operator(
+    model: &Model,
+    a: ContactSide,
+    b: ContactSide,
+    shift: [i32; 2],
+) -> Option<Jump> {
     let first = side_blocks(model, a);
     let second = side_blocks(model, b);
-    if first
-        .iter()
-        .any(|(n, _)| second.iter().any(|(m, _)| m == n))
+    if shift == [0, 0]
+        && first
+            .iter()
+            .any(|(n, ..)| second.iter().any(|(m, ..)| m == n))
     {
         return None;
     }
     let mut jump = Jump {
         nodes: Vec::with_capacity(4),
+        shifts: Vec::with_capacity(4),
         b: JumpMatrix::zeros(),
+        r: JumpMatrix::zeros(),
     };
-    for (sign, blocks) in [(1.0, first), (-1.0, second)] {
-        for (n, m) in blocks {
+    for (sign, s, blocks) in [(1.0, [0, 0], first), (-1.0, shift, second)] {
+        for (n, mu, mr) in blocks {
             let k = jump.nodes.len();
             jump.nodes.push(n);
+            jump.shifts.push(s);
             jump.b
                 .fixed_view_mut::<3, 6>(0, 6 * k)
-                .copy_from(&(m * sign));
+                .copy_from(&(mu * sign));
+            jump.r
+                .fixed_view_mut::<3, 6>(0, 6 * k)
+                .copy_from(&(mr * sign));
         }
     }
     Some(jump)

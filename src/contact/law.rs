@@ -8,7 +8,13 @@
 //!   tangential force is F_t = p_T (Eᵀ B q − s);
 //! * Coulomb slip (4.63, 4.64): F_t = μ N d along the slip direction d, so
 //!   K_T = μ p_N Bᵀ E d nᵀ B (rank one, **nonsymmetric**), F_T = μ p_N ḡ Bᵀ E d;
-//! * Tresca slip (4.65): F_t = G d, a constant load F_T = −G Bᵀ E d.
+//! * Tresca slip (4.65): F_t = G d, a constant load F_T = −G Bᵀ E d;
+//! * rolling resistance (not in the thesis): K_R = p_R Rᵀ R on the relative rotation [θ] = R q of
+//!   a closed contact, moment M = p_R R q. A point contact transmits forces only, so fibers held
+//!   by crossings alone can roll on each other without straining anything (warps spinning about
+//!   their axes while wefts translate); a real contact is a patch and resists that. p_R is the
+//!   rotational stiffness of a uniform normal penalty over a disc of radius a, p_N a²/4, with a
+//!   default a of half the smaller fiber radius; p_R = 0 gives the thesis's point contact.
 //!
 //! E is built from the tangent of fiber I projected on the tangent plane; for fibers crossing
 //! at right angles its two vectors are the two fiber tangents of the thesis.
@@ -76,6 +82,8 @@ pub struct ContactPair {
     pub penalty_normal: f64,
     /// Tangential penalty p_T (N/m).
     pub penalty_tangent: f64,
+    /// Rolling and twisting resistance p_R (N·m/rad); 0 for a point contact.
+    pub penalty_rotation: f64,
 }
 
 /// Tangent-plane basis from a preferred direction (projected) and the normal.
@@ -132,6 +140,16 @@ impl ContactPair {
             bn * bn.transpose() * self.penalty_normal,
             bn * (self.penalty_normal * self.gap),
         )
+    }
+
+    /// K_R = p_R Rᵀ R of the rolling resistance of a closed contact (stick or slip).
+    pub fn rotation(&self) -> BlockMatrix {
+        self.jump.r.transpose() * self.jump.r * self.penalty_rotation
+    }
+
+    /// The resisting moment p_R [θ] (N·m) for the block DOFs `q`.
+    pub fn rotation_moment(&self, q: &BlockVector) -> Vector3<f64> {
+        self.jump.r * q * self.penalty_rotation
     }
 
     /// K_T^st and F_T of a stuck contact with accumulated slip `slip` (4.58).

@@ -2,6 +2,7 @@
 //! tangent bases, gaps and penalties; initially penetrating pairs are counted and handled.
 
 use super::{find_candidates, jump_operator, tangent_basis, Candidate, ContactPair, ContactSide};
+use crate::cell::Periodicity;
 use crate::element::local_frame;
 use crate::model::{Model, ModelError, PenetrationSpec};
 use nalgebra::Vector3;
@@ -13,21 +14,24 @@ pub struct ContactOrigin {
     pub kind: &'static str,
     /// The two sides.
     pub sides: [ContactSide; 2],
+    /// Periods (i, j) by which the image of side II is shifted (\[0, 0\] unless the contact
+    /// crosses the boundary of a periodic cell).
+    pub shift: [i32; 2],
     /// Fiber ids of the two sides (for a node, the first fiber through it).
     pub fibers: [u64; 2],
     /// Position of the contact point of side I (m).
     pub point: [f64; 3],
 }
 
-/// (origin, sides, normal, gap, normal penalty, tangential penalty) before validation.
-type RawPair = (
-    &'static str,
-    [ContactSide; 2],
-    Vector3<f64>,
-    f64,
-    Option<f64>,
-    Option<f64>,
-);
+/// A pair before validation.
+struct RawPair {
+    kind: &'static str,
+    sides: [ContactSide; 2],
+    shift: [i32; 2],
+    normal: Vector3<f64>,
+    gap: f64,
+    penalties: [Option<f64>; 3],
+}
 
 /// Initially penetrating pairs.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -93,6 +97,25 @@ pub fn default_penalty(model: &Model, sides: [ContactSide; 2]) -> f64 {
             .fold(0.0, f64::max)
 }
 
+/// Default rolling resistance p_N a²/4, with a half the smaller fiber radius of the two sides:
+/// the rotational stiffness of the normal penalty spread over a disc of radius a.
+pub fn default_rotation_penalty(
+    model: &Model,
+    sides: [ContactSide; 2],
+    penalty_normal: f64,
+) -> f64 {
+    let radius = sides
+        .iter()
+        .flat_map(|&s| side_elements(model, s))
+        .map(|e| model.fibers[model.elements()[e].fiber].section.radius)
+        .fold(f64::INFINITY, f64::min);
+    if radius.is_finite() {
+        penalty_normal * (0.5 * radius).powi(2) / 4.0
+    } else {
+        0.0
+    }
+}
+
 /// A contact point at an element end is the node itself (the interpolation there is exactly the
 /// nodal translation), so that the same crossing seen from two adjacent elements is one side.
 fn side_of(model: &Model, element: usize, xi: f64) -> ContactSide {
@@ -107,74 +130,103 @@ fn side_of(model: &Model, element: usize, xi: f64) -> ContactSide {
 }
 
 /// One crossing of two fibers is seen by every pair of their elements near it (two or four
-/// when it lies at or near element ends). Per pair of fibers, candidates whose contact points
-/// lie within the sum of the two diameters of a closer one are the same contact and dropped.
-fn merge_duplicates(model: &Model, mut found: Vec<Candidate>) -> Vec<Candidate> {
+/// when it lies at or near element ends, and in a cell possibly once on each side of the
+/// boundary). Per pair of fibers, candidates whose contact points lie within the sum of the two
+/// diameters of a closer one — positions compared modulo the periods — are the same contact and
+/// dropped.
+fn merge_duplicates(
+    model: &Model,
+    cell: Option<&Periodicity>,
+    mut found: Vec<Candidate>,
+) -> Vec<Candidate> {
+    let period = cell.map_or([0.0; 2], |p| p.geometry.size);
     let fiber = |e: usize| model.elements()[e].fiber;
-    let point = |e: usize, xi: f64| {
+    let key = |x: &Candidate| {
+        let (a, b) = (fiber(x.elements[0]), fiber(x.elements[1]));
+        (a.min(b), a.max(b))
+    };
+    let point = |e: usize, xi: f64, shift: [i32; 2]| {
         let el = model.elements()[e];
         let (p, q) = (
             Vector3::from(model.nodes[el.nodes[0]].x),
             Vector3::from(model.nodes[el.nodes[1]].x),
         );
-        p + (q - p) * xi
+        let offset = Vector3::new(
+            f64::from(shift[0]) * period[0],
+            f64::from(shift[1]) * period[1],
+            0.0,
+        );
+        p + (q - p) * xi + offset
+    };
+    // A difference of positions reduced to the nearest period.
+    let wrap = |mut d: Vector3<f64>| {
+        for k in 0..2 {
+            if period[k] > 0.0 {
+                d[k] -= period[k] * (d[k] / period[k]).round();
+            }
+        }
+        d
     };
     found.sort_by(|a, b| {
-        let ka = (
-            fiber(a.elements[0]).min(fiber(a.elements[1])),
-            fiber(a.elements[0]).max(fiber(a.elements[1])),
-        );
-        let kb = (
-            fiber(b.elements[0]).min(fiber(b.elements[1])),
-            fiber(b.elements[0]).max(fiber(b.elements[1])),
-        );
-        ka.cmp(&kb)
+        key(a)
+            .cmp(&key(b))
             .then(a.distance.total_cmp(&b.distance))
             .then(a.elements.cmp(&b.elements))
+            .then(a.shift.cmp(&b.shift))
     });
     let mut kept: Vec<Candidate> = Vec::with_capacity(found.len());
     let mut group_start = 0;
     for c in found {
-        let key = |x: &Candidate| {
-            (
-                fiber(x.elements[0]).min(fiber(x.elements[1])),
-                fiber(x.elements[0]).max(fiber(x.elements[1])),
-            )
-        };
         if kept.get(group_start).is_some_and(|g| key(g) != key(&c)) {
             group_start = kept.len();
         }
         let reach = 2.0 * (c.distance - c.gap);
-        let (pa, pb) = (point(c.elements[0], c.xi[0]), point(c.elements[1], c.xi[1]));
+        let pa = point(c.elements[0], c.xi[0], [0, 0]);
+        let pb = point(c.elements[1], c.xi[1], c.shift);
         let duplicate = kept[group_start..].iter().any(|k| {
-            let (qa, qb) = (point(k.elements[0], k.xi[0]), point(k.elements[1], k.xi[1]));
-            // Compare whichever way round the pair was found.
-            let same = (pa - qa).norm().max((pb - qb).norm());
-            let swapped = (pa - qb).norm().max((pb - qa).norm());
+            let qa = point(k.elements[0], k.xi[0], [0, 0]);
+            let qb = point(k.elements[1], k.xi[1], k.shift);
+            // Compare whichever way round the pair was found: the same first point (modulo
+            // the periods) and the same offset to the second.
+            let same = wrap(pa - qa).norm().max(((pb - pa) - (qb - qa)).norm());
+            let swapped = wrap(pa - qb).norm().max(((pb - pa) - (qa - qb)).norm());
             same.min(swapped) < reach
         });
         if !duplicate {
             kept.push(c);
         }
     }
-    kept.sort_by_key(|c| c.elements);
+    kept.sort_by_key(|c| (c.elements, c.shift));
     kept
 }
 
 impl ContactSet {
-    /// Builds the pairs of `model` (empty without `[contact]`).
+    /// Builds the pairs of `model` (empty without `[contact]`), without periodic images.
     pub fn build(model: &Model) -> Result<Self, ModelError> {
+        Self::build_with(model, None)
+    }
+
+    /// Builds the pairs of `model`; with `cell`, the search also finds contacts with the
+    /// periodic images of the elements (across the cell boundary).
+    pub fn build_with(model: &Model, cell: Option<&Periodicity>) -> Result<Self, ModelError> {
         let Some(settings) = &model.contact else {
             return Ok(ContactSet::default());
         };
         let mut raw: Vec<RawPair> = Vec::new();
         if settings.search {
-            for c in merge_duplicates(model, find_candidates(model, settings.tolerance)) {
-                let sides = [
-                    side_of(model, c.elements[0], c.xi[0]),
-                    side_of(model, c.elements[1], c.xi[1]),
-                ];
-                raw.push(("search", sides, Vector3::from(c.normal), c.gap, None, None));
+            let found = find_candidates(model, settings.tolerance, cell);
+            for c in merge_duplicates(model, cell, found) {
+                raw.push(RawPair {
+                    kind: "search",
+                    sides: [
+                        side_of(model, c.elements[0], c.xi[0]),
+                        side_of(model, c.elements[1], c.xi[1]),
+                    ],
+                    shift: c.shift,
+                    normal: Vector3::from(c.normal),
+                    gap: c.gap,
+                    penalties: [None; 3],
+                });
             }
         }
         for (k, x) in model.explicit_contacts.iter().enumerate() {
@@ -192,18 +244,26 @@ impl ContactSet {
                     d.normalize()
                 }
             };
-            raw.push((
-                "explicit",
+            raw.push(RawPair {
+                kind: "explicit",
                 sides,
+                shift: [0, 0],
                 normal,
-                x.gap,
-                x.penalty_normal,
-                x.penalty_tangent,
-            ));
+                gap: x.gap,
+                penalties: [x.penalty_normal, x.penalty_tangent, x.penalty_rotation],
+            });
         }
         let mut set = ContactSet::default();
-        for (k, (kind, sides, normal, gap, pn, pt)) in raw.into_iter().enumerate() {
-            let jump = jump_operator(model, sides[0], sides[1]).ok_or_else(|| {
+        for (k, pair) in raw.into_iter().enumerate() {
+            let RawPair {
+                kind,
+                sides,
+                shift,
+                normal,
+                gap,
+                penalties: [pn, pt, pr],
+            } = pair;
+            let jump = jump_operator(model, sides[0], sides[1], shift).ok_or_else(|| {
                 ModelError::InvalidContact {
                     item: format!("contact pair {}", k + 1),
                     message: "its two sides share a node".into(),
@@ -221,6 +281,9 @@ impl ContactSet {
                 .or(settings.penalty_normal)
                 .unwrap_or_else(|| default_penalty(model, sides));
             let penalty_tangent = pt.or(settings.penalty_tangent).unwrap_or(penalty_normal);
+            let penalty_rotation = pr
+                .or(settings.penalty_rotation)
+                .unwrap_or_else(|| default_rotation_penalty(model, sides, penalty_normal));
             let mut gap = gap;
             if gap < 0.0 {
                 set.penetration.count += 1;
@@ -239,6 +302,7 @@ impl ContactSet {
             set.origins.push(ContactOrigin {
                 kind,
                 sides,
+                shift,
                 fibers: [fiber_of(sides[0]), fiber_of(sides[1])],
                 point: [p[0], p[1], p[2]],
             });
@@ -249,6 +313,7 @@ impl ContactSet {
                 gap,
                 penalty_normal,
                 penalty_tangent,
+                penalty_rotation,
             });
         }
         Ok(set)

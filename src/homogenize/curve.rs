@@ -4,9 +4,8 @@
 //! switch), the elastic/plastic split (5.5–5.6) and the dissipated energy.
 
 use super::homogenize_elastic;
-use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain};
+use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
-use crate::contact::ContactSet;
 use crate::model::Model;
 use crate::solve::{run_incremental, IncrementalOptions, IncrementalSolution};
 use crate::Error;
@@ -103,11 +102,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
         ));
     }
     let elastic = homogenize_elastic(model, &opts.incremental.solve)?;
-    let p = pair_boundary_nodes(model)?;
-    let set = ContactSet::build(model)?;
-    let links = crate::homogenize::system::contact_links(model, &set);
-    check_percolation(model, &p, &links)?;
-    let anchor = anchor_node(model, &p)?;
+    let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, false)?;
     let disc = Discretization::periodic(model, &p, &opts.strain, anchor);
     let n = opts.steps;
     let mut path: Vec<f64> = (1..=n).map(|k| k as f64 / n as f64).collect();

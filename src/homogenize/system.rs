@@ -3,7 +3,8 @@
 //! macroscopic quantities E as driver DOFs; element and contact matrices become Tᵀ K T, so the
 //! reduced system stays symmetric positive definite; the reactions of the drivers are the stress
 //! resultants times the cell area. Closed contacts (gap ≤ 0) enter as stick springs
-//! (K_N + K_T^st): the elastic moduli A^elas of thesis (5.5).
+//! (K_N + K_T^st, plus the rolling resistance K_R): the elastic moduli A^elas of thesis (5.5).
+//! Contacts are searched with the periodic images, so crossings on the boundary count.
 
 use crate::assembly::{element_stiffness, Pattern, NO_SLOT};
 use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain, Periodicity};
@@ -39,38 +40,57 @@ pub struct PeriodicSystem {
     pub anchor: usize,
 }
 
-/// Node pairs joined by the contact pairs (for connectivity checks).
-pub(crate) fn contact_links(model: &Model, set: &ContactSet) -> Vec<[usize; 2]> {
+/// Node pairs joined by the contact pairs `which` (for connectivity checks), with the period
+/// shift of the second side's image.
+fn contact_links(
+    model: &Model,
+    set: &ContactSet,
+    which: impl Iterator<Item = usize>,
+) -> Vec<([usize; 2], [i32; 2])> {
     let node = |s: ContactSide| match s {
         ContactSide::Node(n) => n,
         ContactSide::Point { element, .. } => model.elements()[element].nodes[0],
     };
-    set.origins
-        .iter()
-        .map(|o| [node(o.sides[0]), node(o.sides[1])])
+    which
+        .map(|i| {
+            let o = &set.origins[i];
+            ([node(o.sides[0]), node(o.sides[1])], o.shift)
+        })
         .collect()
+}
+
+/// What every cell problem starts from: the boundary pairing, the contacts (searched with the
+/// periodic images), the percolation check — through the closed contacts only when
+/// `closed_only`, otherwise through every contact — and the anchor node.
+pub(crate) fn prepare_cell(
+    model: &Model,
+    closed_only: bool,
+) -> Result<(Periodicity, ContactSet, usize), Error> {
+    let periodicity = pair_boundary_nodes(model)?;
+    if !model.supports.is_empty() {
+        return Err(Error::InvalidOption(
+            "a periodic cell is driven by macroscopic strains: remove its [[supports]]".into(),
+        ));
+    }
+    let set = ContactSet::build_with(model, Some(&periodicity))?;
+    let links = contact_links(
+        model,
+        &set,
+        (0..set.pairs.len()).filter(|&i| !closed_only || set.pairs[i].gap <= 0.0),
+    );
+    check_percolation(model, &periodicity, &links)?;
+    let anchor = anchor_node(model, &periodicity)?;
+    Ok((periodicity, set, anchor))
 }
 
 impl PeriodicSystem {
     /// Pairs the boundary, finds the contacts, checks percolation, numbers the unknowns and
     /// builds the pattern.
     pub fn new(model: &Model) -> Result<Self, Error> {
-        let periodicity = pair_boundary_nodes(model)?;
-        if !model.supports.is_empty() {
-            return Err(Error::InvalidOption(
-                "a periodic cell is driven by macroscopic strains: remove its [[supports]]".into(),
-            ));
-        }
-        let set = ContactSet::build(model)?;
+        let (periodicity, set, anchor) = prepare_cell(model, true)?;
         let closed: Vec<usize> = (0..set.pairs.len())
             .filter(|&i| set.pairs[i].gap <= 0.0)
             .collect();
-        let links: Vec<[usize; 2]> = {
-            let all = contact_links(model, &set);
-            closed.iter().map(|&i| all[i]).collect()
-        };
-        check_percolation(model, &periodicity, &links)?;
-        let anchor = anchor_node(model, &periodicity)?;
         let discretization = Discretization::periodic(model, &periodicity, &[0.0; 6], anchor);
         let elements: Vec<(Vec<usize>, DMatrix<f64>)> = model
             .elements()
@@ -164,7 +184,8 @@ impl PeriodicSystem {
             let m = pair.size();
             let (kn, _) = pair.normal();
             let (kt, _) = pair.stick(&Vector2::zeros());
-            let k = DMatrix::from_fn(m, m, |r, c| kn[(r, c)] + kt[(r, c)]);
+            let kr = pair.rotation();
+            let k = DMatrix::from_fn(m, m, |r, c| kn[(r, c)] + kt[(r, c)] + kr[(r, c)]);
             scatter(&pair.jump.nodes, &k, self.pattern.extra_slots(i));
         }
         out

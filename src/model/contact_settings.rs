@@ -15,6 +15,8 @@ pub struct ContactSettings {
     pub penalty_normal: Option<f64>,
     /// Tangential penalty, or equal to the normal one.
     pub penalty_tangent: Option<f64>,
+    /// Rolling resistance (N·m/rad), or automatic.
+    pub penalty_rotation: Option<f64>,
     /// Friction law.
     pub friction: Friction,
     /// Initially penetrating pairs.
@@ -36,6 +38,8 @@ pub struct ExplicitContact {
     pub penalty_normal: Option<f64>,
     /// Tangential penalty override (N/m).
     pub penalty_tangent: Option<f64>,
+    /// Rolling resistance override (N·m/rad).
+    pub penalty_rotation: Option<f64>,
 }
 
 fn invalid(item: &str, message: String) -> ModelError {
@@ -55,6 +59,16 @@ fn check_penalty(item: &str, what: &str, p: Option<f64>) -> Result<(), ModelErro
     }
 }
 
+fn check_rotation_penalty(item: &str, p: Option<f64>) -> Result<(), ModelError> {
+    match p {
+        Some(v) if !(v.is_finite() && v >= 0.0) => Err(invalid(
+            item,
+            format!("penalty_rotation = {v} must be finite and ≥ 0"),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Validates `[contact]`; `max_radius` gives the default search tolerance.
 pub(super) fn check_settings(
     spec: &ContactSpec,
@@ -63,6 +77,7 @@ pub(super) fn check_settings(
     let item = "[contact]";
     check_penalty(item, "penalty_normal", spec.penalty_normal)?;
     check_penalty(item, "penalty_tangent", spec.penalty_tangent)?;
+    check_rotation_penalty(item, spec.penalty_rotation)?;
     let tolerance = spec.tolerance.unwrap_or(max_radius);
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(invalid(
@@ -96,6 +111,7 @@ pub(super) fn check_settings(
         tolerance,
         penalty_normal: spec.penalty_normal,
         penalty_tangent: spec.penalty_tangent,
+        penalty_rotation: spec.penalty_rotation,
         friction,
         initial_penetration: spec.initial_penetration.unwrap_or(PenetrationSpec::Adjust),
     })
@@ -112,6 +128,7 @@ pub(super) fn check_pair(
     let b = side(&spec.b).map_err(|m| invalid(&item, m))?;
     check_penalty(&item, "penalty_normal", spec.penalty_normal)?;
     check_penalty(&item, "penalty_tangent", spec.penalty_tangent)?;
+    check_rotation_penalty(&item, spec.penalty_rotation)?;
     if !spec.gap.is_finite() {
         return Err(invalid(&item, format!("gap = {} is not finite", spec.gap)));
     }
@@ -135,5 +152,6 @@ pub(super) fn check_pair(
         gap: spec.gap,
         penalty_normal: spec.penalty_normal,
         penalty_tangent: spec.penalty_tangent,
+        penalty_rotation: spec.penalty_rotation,
     })
 }

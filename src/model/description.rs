@@ -123,6 +123,10 @@ pub struct ContactSpec {
     /// Tangential penalty p_T (N/m); default equal to the normal penalty.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub penalty_tangent: Option<f64>,
+    /// Rolling and twisting resistance p_R of a closed contact (N·m/rad, ≥ 0; 0: the thesis's
+    /// point contact); default p_N a²/4 with a half the smaller fiber radius.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty_rotation: Option<f64>,
     /// Friction law.
     #[serde(default)]
     pub friction: FrictionSpec,
@@ -186,6 +190,9 @@ pub struct ContactPairSpec {
     /// Tangential penalty for this pair (N/m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub penalty_tangent: Option<f64>,
+    /// Rolling resistance for this pair (N·m/rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty_rotation: Option<f64>,
 }
 
 /// A contact side: `{ node = 3 }` or `{ fiber = 2, segment = 0, xi = 0.5 }` (the point at

@@ -151,7 +151,9 @@ struct Trial {
 /// Return mapping of one contact for the block displacement `q` and committed slip `s`.
 /// `previous` is the state the system was solved with: within the tolerances (`length_tol` on
 /// the penetration, a relative 1e-10 on the friction bound) a contact keeps it, so a contact
-/// exactly at the switch point does not flip back and forth.
+/// exactly at the switch point does not flip back and forth. A trial tangential force below
+/// p_T · `length_tol` is roundoff: a closed contact keeps its state and slip direction (a
+/// contact that carries nothing would otherwise slide in a direction set by noise).
 fn classify(
     pair: &ContactPair,
     friction: Friction,
@@ -196,6 +198,16 @@ fn classify(
         Friction::Coulomb { mu } => mu * t.normal_force,
         Friction::Tresca { bound } => bound,
     };
+    if closed_before && friction != Friction::None && norm <= pair.penalty_tangent * length_tol {
+        t.state = previous;
+        if previous == ContactState::Slip {
+            t.direction = previous_direction;
+            t.tangential = previous_direction * t.bound;
+        } else {
+            t.tangential = trial;
+        }
+        return t;
+    }
     let margin = if previous == ContactState::Slip {
         1.0 - 1e-10
     } else {
@@ -540,7 +552,7 @@ pub(crate) fn run_incremental(
                         (k, f)
                     }
                 };
-                k += kt;
+                k += kt + pair.rotation();
                 f += ft;
                 let m = pair.size();
                 let slots = pattern.extra_slots(i);
@@ -667,7 +679,11 @@ pub(crate) fn run_incremental(
             let ft: Vector3<f64> =
                 pair.tangents[0] * t.tangential[0] + pair.tangents[1] * t.tangential[1];
             let force = pair.normal * t.normal_force + ft;
-            let fq = pair.jump.b.transpose() * force;
+            let mut fq = pair.jump.b.transpose() * force;
+            if t.state != ContactState::Open {
+                let q_block = gather(&q, &pair.jump.nodes);
+                fq += pair.jump.r.transpose() * pair.rotation_moment(&q_block);
+            }
             for (k, &n) in pair.jump.nodes.iter().enumerate() {
                 for d in 0..6 {
                     forces[6 * n + d] += fq[6 * k + d];
