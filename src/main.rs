@@ -343,6 +343,10 @@ fn homogenize(
             let name = format!("case_{}.vtu", fibercell::cell::MACRO_NAMES[k]);
             write(&out.join(name), &io::deformed_vtu(&model, case))?;
         }
+        write(
+            &out.join("case_pressure.vtu"),
+            &io::deformed_vtu(&model, &h.pressure.displacements),
+        )?;
     }
     if json {
         println!("{pretty}");
@@ -379,6 +383,12 @@ fn homogenize(
     println!(
         "orthotropic: E1 {:.5e} N/m ({:.5e} Pa)  E2 {:.5e} N/m ({:.5e} Pa)  G12 {:.5e} N/m ({:.5e} Pa)  nu12 {:.5}  nu21 {:.5}",
         o.e1, o.e1_pa, o.e2, o.e2_pa, o.g12, o.g12_pa, o.nu12, o.nu21
+    );
+    let b = &h.pressure.b_hom;
+    println!(
+        "pressure (1 Pa down on the {:.1} % of the cell seen from above, balanced by a body force): B_hom N11 {:.5e} N22 {:.5e} N12 {:.5e} m;  M11 {:.5e} M22 {:.5e} M12 {:.5e} m²",
+        100.0 * h.pressure.coverage,
+        b[0], b[1], b[2], b[3], b[4], b[5]
     );
     Ok(())
 }

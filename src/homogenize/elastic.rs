@@ -1,13 +1,17 @@
 //! The six elastic cell problems (thesis 3.13–3.16 for a frame network): one factorization,
 //! six right-hand sides −K_fE e_k, and ABD = (K_EE − K_Ef K_ff⁻¹ K_fE) / |Y|, the Schur
-//! complement of the driver DOFs per unit cell area — symmetric by construction.
+//! complement of the driver DOFs per unit cell area — symmetric by construction. A seventh
+//! right-hand side is the out-of-plane pressure problem Θ (3.28, 5.2): its driver reactions per
+//! unit area are B^hom (5.4).
 
+use super::pressure::{default_pixel, pressure_load};
 use super::{Orthotropic, PeriodicSystem, ThesisModuli};
-use crate::cell::CellGeometry;
+use crate::cell::{macro_matrix, CellGeometry};
 use crate::model::Model;
 use crate::solve::{check_backward_error, locate, make_solver, SolveOptions};
 use crate::Error;
 use fibercell_solver::{solve_checked, SolverError};
+use nalgebra::DMatrix;
 use serde::Serialize;
 
 /// Effective properties of a cell.
@@ -36,12 +40,33 @@ pub struct Homogenized {
     pub backward_error: f64,
     /// Backend.
     pub backend: String,
+    /// The out-of-plane pressure problem.
+    pub pressure: PressureResponse,
     /// For each unit load case k, the nodal displacements (the cell-problem solutions N_q).
     #[serde(skip)]
     pub cases: Vec<Vec<[f64; 6]>>,
     /// Cell geometry.
     #[serde(skip)]
     pub geometry: Option<CellGeometry>,
+}
+
+/// The response of the cell to a unit out-of-plane pressure (1 Pa pushing the top face down,
+/// balanced by a uniform body force, zero macroscopic strain).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PressureResponse {
+    /// B^hom (5.4): the volume-averaged resultants per unit pressure, N11, N22, N12 (N/m per
+    /// Pa = m) and M11, M22, M12 (N per Pa = m²): the driver reactions plus the virial Σ M(x)ᵀ f
+    /// of the load, which by reciprocity equals −(1/|Y|) × the work of the load on the periodic
+    /// fluctuation of each unit cell problem. The thesis's p is the outward traction: its
+    /// B^hom is the negative of this one.
+    pub b_hom: [f64; 6],
+    /// Fraction of the cell area that sees a fiber from above (where the pressure acts).
+    pub coverage: f64,
+    /// Pixel size of the top-surface sampling (m).
+    pub pixel: f64,
+    /// Nodal displacements and rotations per unit pressure (the solution Θ).
+    #[serde(skip)]
+    pub displacements: Vec<[f64; 6]>,
 }
 
 /// Solves the six unit cell problems of `model` (which needs a `[cell]`) and returns ABD and
@@ -56,16 +81,60 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
     let locate = |e: SolverError| locate(e, model, &node_dof);
     solver.analyze(a).map_err(locate)?;
     solver.factorize(a).map_err(locate)?;
-    let mut rhs = vec![0.0; 6 * n];
+    let g = sys.periodicity.geometry;
+    let area = g.area();
+    let disc = &sys.discretization;
+    let driver = disc.driver().unwrap_or(usize::MAX);
+    let mut rhs = vec![0.0; 7 * n];
     for (i, c) in vals.coupling.iter().enumerate() {
         for k in 0..6 {
             rhs[k * n + i] = -c[k];
         }
     }
-    let (x, report) = solve_checked(solver.as_mut(), a, &rhs, 6).map_err(locate)?;
+    // The Θ load, moved onto the generalized DOFs (Tᵀ f, periodic images included), and its
+    // virial Σ M(x)ᵀ f over the loaded points (images at their shifted positions).
+    let load = pressure_load(model, &g, 1.0, default_pixel(model));
+    let (mut driver_load, mut virial) = ([0.0; 6], [0.0; 6]);
+    for (e, shift, f) in &load.elements {
+        let nodes = model.elements()[*e].nodes;
+        let (gnodes, t) = disc.block_of_images(&nodes, &[*shift, *shift]);
+        let fg = t.transpose() * DMatrix::from_column_slice(12, 1, f.as_slice());
+        for (c, &gn) in gnodes.iter().enumerate() {
+            for d in 0..6 {
+                if gn == driver {
+                    driver_load[d] += fg[6 * c + d];
+                } else if let Some(r) = disc.reduced(6 * gn + d) {
+                    rhs[6 * n + r] += fg[6 * c + d];
+                }
+            }
+        }
+        for (a, &node) in nodes.iter().enumerate() {
+            let x = g.relative(&model.nodes[node].x);
+            let m = macro_matrix(
+                x[0] + f64::from(shift[0]) * g.size[0],
+                x[1] + f64::from(shift[1]) * g.size[1],
+                x[2],
+            );
+            for (k, v) in virial.iter_mut().enumerate() {
+                *v += (0..6).map(|d| m[(d, k)] * f[6 * a + d]).sum::<f64>();
+            }
+        }
+    }
+    let (x, report) = solve_checked(solver.as_mut(), a, &rhs, 7).map_err(locate)?;
     check_backward_error(options, report.backward_error, "cell problems")?;
-    let g = sys.periodicity.geometry;
-    let area = g.area();
+    let theta = &x[6 * n..7 * n];
+    // Driver reaction (internal force minus the load on the drivers) plus the load virial: the
+    // volume average of the stress, as (5.4) defines it.
+    let b_hom: [f64; 6] = std::array::from_fn(|k| {
+        let reaction: f64 = (0..n).map(|i| vals.coupling[i][k] * theta[i]).sum();
+        (reaction - driver_load[k] + virial[k]) / area
+    });
+    let pressure = PressureResponse {
+        b_hom,
+        coverage: load.coverage,
+        pixel: load.pixel,
+        displacements: sys.expand(theta, &[0.0; 6]),
+    };
     let mut abd = [[0.0; 6]; 6];
     for (j, row) in abd.iter_mut().enumerate() {
         for (k, v) in row.iter_mut().enumerate() {
@@ -98,6 +167,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
         contacts: sys.n_contacts(),
         backward_error: report.backward_error,
         backend: report.backend.to_string(),
+        pressure,
         cases,
         geometry: Some(g),
     })

@@ -1,13 +1,16 @@
 //! Asymptotic homogenization of a periodic cell (thesis §3.1.4, §5.1): the six elastic cell
 //! problems driven by unit macroscopic strains, the ABD stiffness per unit cell area, the
-//! thesis's moduli and the orthotropic constants of §5.1.2.
+//! thesis's moduli and the orthotropic constants of §5.1.2, and the out-of-plane pressure problem
+//! Θ with its B^hom (§3.2, 5.2, 5.4).
 
 mod curve;
 mod elastic;
 mod orthotropic;
+mod pressure;
 pub(crate) mod system;
 
 pub use curve::{elasto_plastic_curve, Curve, CurveOptions, CurvePoint, Segment, SwitchEvent};
-pub use elastic::{homogenize_elastic, Homogenized};
+pub use elastic::{homogenize_elastic, Homogenized, PressureResponse};
 pub use orthotropic::{Orthotropic, ThesisModuli};
+pub use pressure::{default_pixel, pressure_load, PressureLoad};
 pub use system::PeriodicSystem;

@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: small model builders.
 #![allow(dead_code)]
 
+pub mod zigzag;
+
 use fibercell::model::{
     DofSet, FiberSpec, LoadSpec, MaterialSpec, ModelDescription, NodeSpec, SupportSpec,
 };
