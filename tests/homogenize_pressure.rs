@@ -28,19 +28,31 @@ fn homogenize(d: &fibercell::model::ModelDescription) -> (Model, Homogenized) {
     (m, h)
 }
 
-#[test]
-fn a_flat_network_has_no_pressure_resultants() {
-    let (lx, ly, r) = (4e-3, 3e-3, 2e-4);
-    let d = GridCell {
+const R: f64 = 2e-4;
+
+/// A grid cell with fixed junctions at the given fractions of the periods.
+fn grid(
+    size: [f64; 2],
+    joint: [f64; 2],
+    periods: [usize; 2],
+    sub: usize,
+) -> fibercell::model::ModelDescription {
+    GridCell {
         young: 1e9,
         poisson: 0.3,
-        radius: r,
-        size: [lx, ly],
-        joint: [0.3 * lx, 0.6 * ly],
-        periods: [2, 1],
-        sub: 3,
+        radius: R,
+        size,
+        joint: [joint[0] * size[0], joint[1] * size[1]],
+        periods,
+        sub,
     }
-    .build();
+    .build()
+}
+
+#[test]
+fn a_flat_network_has_no_pressure_resultants() {
+    let (lx, ly) = (4e-3, 3e-3);
+    let d = grid([lx, ly], [0.3, 0.6], [2, 1], 3);
     let (_, h) = homogenize(&d);
     let p = &h.pressure;
     assert!(p.coverage > 0.1 && p.coverage < 1.0);
@@ -115,17 +127,8 @@ fn b_hom_is_the_work_of_the_pressure_on_the_unit_cell_problems() {
 
 #[test]
 fn the_pressure_acts_on_the_covered_area() {
-    let (lx, ly, r) = (4e-3, 5e-3, 2e-4);
-    let d = GridCell {
-        young: 1e9,
-        poisson: 0.3,
-        radius: r,
-        size: [lx, ly],
-        joint: [0.37 * lx, 0.61 * ly],
-        periods: [1, 1],
-        sub: 2,
-    }
-    .build();
+    let (lx, ly, r) = (4e-3, 5e-3, R);
+    let d = grid([lx, ly], [0.37, 0.61], [1, 1], 2);
     let m = Model::from_description(&d).unwrap();
     let g = fibercell::cell::pair_boundary_nodes(&m).unwrap().geometry;
     let pixel = r / 16.0;
