@@ -147,7 +147,7 @@ impl ContactPair {
         self.jump.r.transpose() * self.jump.r * self.penalty_rotation
     }
 
-    /// The resisting moment p_R [θ] (N·m) for the block DOFs `q`.
+    /// The resisting moment p_R \[θ\] (N·m) for the block DOFs `q`.
     pub fn rotation_moment(&self, q: &BlockVector) -> Vector3<f64> {
         self.jump.r * q * self.penalty_rotation
     }
