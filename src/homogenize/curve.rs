@@ -4,6 +4,7 @@
 //! switch), the elastic/plastic split (5.5–5.6) and the dissipated energy.
 
 use super::homogenize_elastic;
+use super::segments::{linear_pieces, Segment};
 use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
 use crate::model::Model;
@@ -56,21 +57,15 @@ pub struct SwitchEvent {
     pub contact: usize,
     /// Increment at which the new state is first seen.
     pub step: usize,
-    /// Macroscopic strain there.
+    /// Macroscopic strain at the end of that increment.
     pub strain: [f64; 6],
+    /// The strain where the switch happened: where the lines of the linear pieces before and
+    /// after it meet (exact for a piecewise-linear response; within the increment).
+    pub estimated_strain: [f64; 6],
     /// Previous state.
     pub from: &'static str,
     /// New state.
     pub to: &'static str,
-}
-
-/// A linear piece of the curve between switches.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Segment {
-    /// First and last increment (the segment starts at the end of the increment before).
-    pub steps: [usize; 2],
-    /// d(resultant)/dα over the piece.
-    pub slope: [f64; 6],
 }
 
 /// The curve and everything derived from it.
@@ -149,43 +144,34 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
                     contact: c + 1,
                     step: k + 1,
                     strain: point.strain,
+                    estimated_strain: point.strain,
                     from: before.state.name(),
                     to: now.state.name(),
                 });
             }
         }
     }
-    // Segments: break where any switch happens or the path turns.
-    let mut breaks: Vec<usize> = switches.iter().map(|s| s.step).collect();
-    for k in 1..points.len().saturating_sub(1) {
-        let (a, b, c) = (points[k - 1].alpha, points[k].alpha, points[k + 1].alpha);
-        if (b - a) * (c - b) < 0.0 {
-            breaks.push(k + 2);
-        }
-    }
+    // Pieces: break where any switch happens or the path turns.
+    let turns: Vec<usize> = (1..points.len().saturating_sub(1))
+        .filter(|&k| {
+            let (a, b, c) = (points[k - 1].alpha, points[k].alpha, points[k + 1].alpha);
+            (b - a) * (c - b) < 0.0
+        })
+        .map(|k| k + 2)
+        .collect();
+    let mut breaks: Vec<usize> = switches
+        .iter()
+        .map(|s| s.step)
+        .chain(turns.iter().copied())
+        .collect();
     breaks.sort_unstable();
     breaks.dedup();
-    let mut segments = Vec::new();
-    let mut start = 1;
-    for end_excl in breaks.into_iter().chain(std::iter::once(points.len() + 1)) {
-        if end_excl <= start {
-            continue;
+    let samples: Vec<(f64, [f64; 6])> = points.iter().map(|p| (p.alpha, p.resultant)).collect();
+    let segments = linear_pieces(&samples, &breaks, &turns, &opts.strain);
+    for s in &mut switches {
+        if let Some(seg) = segments.iter().find(|g| g.steps[0] == s.step) {
+            s.estimated_strain = opts.strain.map(|e| seg.alpha[0] * e);
         }
-        let last = end_excl - 1;
-        let (p0, a0) = if start == 1 {
-            ([0.0; 6], 0.0)
-        } else {
-            (points[start - 2].resultant, points[start - 2].alpha)
-        };
-        let p1 = &points[last - 1];
-        let da = p1.alpha - a0;
-        if da != 0.0 {
-            segments.push(Segment {
-                steps: [start, last],
-                slope: std::array::from_fn(|i| (p1.resultant[i] - p0[i]) / da),
-            });
-        }
-        start = end_excl;
     }
     Ok(Curve {
         elastic_abd: elastic.abd,

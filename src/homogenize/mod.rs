@@ -7,10 +7,12 @@ mod curve;
 mod elastic;
 mod orthotropic;
 mod pressure;
+mod segments;
 pub(crate) mod system;
 
-pub use curve::{elasto_plastic_curve, Curve, CurveOptions, CurvePoint, Segment, SwitchEvent};
+pub use curve::{elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEvent};
 pub use elastic::{homogenize_elastic, Homogenized, PressureResponse};
 pub use orthotropic::{Orthotropic, ThesisModuli};
 pub use pressure::{default_pixel, pressure_load, PressureLoad};
+pub use segments::Segment;
 pub use system::PeriodicSystem;
