@@ -6,7 +6,6 @@ use fibercell::solve::{
 };
 use fibercell::solver::Ordering;
 use fibercell::{io, Error};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -101,30 +100,7 @@ fn parse_solver(s: &str) -> Result<SolverKind, String> {
 }
 
 fn parse_strain(s: &str) -> Result<fibercell::cell::MacroStrain, String> {
-    let mut e = [0.0; 6];
-    for part in s.split(',').filter(|p| !p.trim().is_empty()) {
-        let (name, value) = part
-            .split_once('=')
-            .ok_or_else(|| format!("\"{part}\" is not name=value"))?;
-        let k = fibercell::cell::MACRO_NAMES
-            .iter()
-            .position(|n| *n == name.trim())
-            .ok_or_else(|| {
-                format!(
-                    "unknown strain component \"{}\" (use e11 e22 g12 k11 k22 k12)",
-                    name.trim()
-                )
-            })?;
-        let v: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| format!("\"{}\" is not a number", value.trim()))?;
-        if !v.is_finite() {
-            return Err(format!("{} = {v} is not finite", name.trim()));
-        }
-        e[k] = v;
-    }
-    Ok(e)
+    fibercell::cell::parse_macro_strain(s)
 }
 
 fn parse_ordering(s: &str) -> Result<Ordering, String> {
@@ -402,7 +378,11 @@ fn curve(
 ) -> Result<(), Error> {
     use fibercell::homogenize::{elasto_plastic_curve, CurveOptions};
     let model = io::load_model(model_path)?;
-    let mut incremental = IncrementalOptions::default();
+    let (bar, progress) = progress_bar("curve");
+    let mut incremental = IncrementalOptions {
+        progress: Some(progress),
+        ..IncrementalOptions::default()
+    };
     incremental.solve.solver = solver;
     let c = elasto_plastic_curve(
         &model,
@@ -412,123 +392,53 @@ fn curve(
             unload,
             incremental,
         },
-    )?;
-    std::fs::create_dir_all(out).map_err(|e| Error::Output {
-        path: out.display().to_string(),
-        message: e.to_string(),
-    })?;
-    let names = fibercell::cell::MACRO_NAMES;
-    let mut csv = String::from("step,alpha");
-    for p in ["", "N_", "elastic_", "plastic_"] {
-        for (k, n) in names.iter().enumerate() {
-            let resultant = ["N11", "N22", "N12", "M11", "M22", "M12"][k];
-            let _ = match p {
-                "" => write!(csv, ",{n}"),
-                "N_" => write!(csv, ",{resultant}"),
-                _ => write!(csv, ",{p}{resultant}"),
-            };
-        }
-    }
-    csv.push_str(",open,stick,slip,dissipated\n");
-    for pt in &c.points {
-        let _ = write!(csv, "{},{}", pt.step, pt.alpha);
-        for v in pt
-            .strain
-            .iter()
-            .chain(&pt.resultant)
-            .chain(&pt.elastic)
-            .chain(&pt.plastic)
-        {
-            let _ = write!(csv, ",{v:e}");
-        }
-        let _ = writeln!(
-            csv,
-            ",{},{},{},{:e}",
-            pt.open, pt.stick, pt.slip, pt.dissipated
-        );
-    }
-    let mut sw = String::from("contact,step,from,to");
-    for n in names {
-        let _ = write!(sw, ",{n}");
-    }
-    sw.push('\n');
-    for s in &c.switches {
-        let _ = write!(sw, "{},{},{},{}", s.contact, s.step, s.from, s.to);
-        for v in s.strain {
-            let _ = write!(sw, ",{v:e}");
-        }
-        sw.push('\n');
-    }
-    // Plot the dominant component of the path against its conjugate resultant.
-    let k = (0..6)
-        .max_by(|&a, &b| strain[a].abs().total_cmp(&strain[b].abs()))
-        .unwrap_or(0);
-    let resultant_name = [
-        "N11 (N/m)",
-        "N22 (N/m)",
-        "N12 (N/m)",
-        "M11 (N)",
-        "M22 (N)",
-        "M12 (N)",
-    ][k];
-    let total: Vec<(f64, f64)> = std::iter::once((0.0, 0.0))
-        .chain(c.points.iter().map(|p| (p.strain[k], p.resultant[k])))
-        .collect();
-    let elastic: Vec<(f64, f64)> = std::iter::once((0.0, 0.0))
-        .chain(c.points.iter().map(|p| (p.strain[k], p.elastic[k])))
-        .collect();
-    let markers: Vec<(f64, f64)> = c
-        .switches
-        .iter()
-        .filter(|s| s.to == "slip")
-        .map(|s| (s.strain[k], c.points[s.step - 1].resultant[k]))
-        .collect();
-    let svg = io::line_plot_svg(
-        &format!(
-            "{}: elasto-plastic curve ({} switches to slip)",
-            model_path.display(),
-            markers.len()
-        ),
-        names[k],
-        resultant_name,
-        &[
-            io::Series {
-                points: &total,
-                colour: "steelblue",
-                label: "cell (stick/slip)",
-            },
-            io::Series {
-                points: &elastic,
-                colour: "gray",
-                label: "all stick (A^elas)",
-            },
-        ],
-        &markers,
     );
-    let pretty = to_pretty(&serde_json::to_value(&c).map_err(|e| Error::Output {
-        path: "json".into(),
-        message: e.to_string(),
-    })?)?;
-    write(&out.join("curve.csv"), &csv)?;
-    write(&out.join("switches.csv"), &sw)?;
-    write(&out.join("curve.json"), &pretty)?;
-    write(&out.join("curve.svg"), &svg)?;
+    bar.finish_and_clear();
+    let c = c?;
+    let title = format!(
+        "{}: elasto-plastic curve ({} switches to slip)",
+        model_path.display(),
+        c.switches.iter().filter(|s| s.to == "slip").count()
+    );
+    io::write_curve_files(out, &c, &title)?;
     if json {
-        println!("{pretty}");
+        println!(
+            "{}",
+            to_pretty(&serde_json::to_value(&c).map_err(|e| Error::Output {
+                path: "json".into(),
+                message: e.to_string(),
+            })?)?
+        );
         return Ok(());
     }
+    let k = io::dominant_component(&strain);
     let last = c.points.last();
     println!(
-        "{}: {} increments, {} switches, {} linear segments; final {} = {:.4e}, dissipated {:.4e} J/m²; results in {}",
+        "{}: {} increments, {} switches, {} linear segments; final {} = {:.4e} {}, dissipated {:.4e} J/m²; results in {}",
         model_path.display(),
         c.points.len(),
         c.switches.len(),
         c.segments.len(),
-        resultant_name,
+        io::RESULTANT_NAMES[k],
         last.map_or(0.0, |p| p.resultant[k]),
+        io::RESULTANT_UNITS[k],
         last.map_or(0.0, |p| p.dissipated),
         out.display()
     );
+    for s in c.switches.iter().take(20) {
+        println!(
+            "  contact {} {} → {} at {} = {:.6e} (increment {})",
+            s.contact,
+            s.from,
+            s.to,
+            fibercell::cell::MACRO_NAMES[k],
+            s.estimated_strain[k],
+            s.step
+        );
+    }
+    if c.switches.len() > 20 {
+        println!("  … {} switches in all (switches.csv)", c.switches.len());
+    }
     Ok(())
 }
 

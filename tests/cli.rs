@@ -230,7 +230,7 @@ fn homogenize_prints_abd_and_writes_the_cell_problems() {
 }
 
 #[test]
-fn curve_writes_csv_switches_json_and_svg() {
+fn curve_writes_csv_switches_json_svg_and_png() {
     let out = tmpdir("curve");
     let o = run(&[
         "curve",
@@ -250,6 +250,8 @@ fn curve_writes_csv_switches_json_and_svg() {
     assert!(switches.lines().nth(1).unwrap().contains(",stick,slip,"));
     let svg = std::fs::read_to_string(out.join("curve.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("<polyline") && svg.contains("<circle"));
+    let png = std::fs::read(out.join("curve.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("curve.json")).unwrap()).unwrap();
     assert_eq!(doc["points"].as_array().unwrap().len(), 60);

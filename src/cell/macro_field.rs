@@ -14,6 +14,38 @@ pub const MACRO_NAMES: [&str; 6] = ["e11", "e22", "g12", "k11", "k22", "k12"];
 /// A macroscopic strain E = (ε11, ε22, γ12, κ11, κ22, κ12) (1, 1, 1, 1/m, 1/m, 1/m).
 pub type MacroStrain = [f64; 6];
 
+/// Parses a macroscopic strain written as comma-separated `name=value` pairs with the names of
+/// [`MACRO_NAMES`], e.g. `e11=0.02` or `g12=0.01,k11=2`; components not named are zero.
+pub fn parse_macro_strain(s: &str) -> Result<MacroStrain, String> {
+    let mut e = [0.0; 6];
+    let mut seen = [false; 6];
+    for part in s.split(',').filter(|p| !p.trim().is_empty()) {
+        let (name, value) = part
+            .split_once('=')
+            .ok_or_else(|| format!("\"{part}\" is not name=value"))?;
+        let name = name.trim();
+        let k = MACRO_NAMES.iter().position(|n| *n == name).ok_or_else(|| {
+            format!("unknown strain component \"{name}\" (use e11 e22 g12 k11 k22 k12)")
+        })?;
+        if seen[k] {
+            return Err(format!("strain component {name} given twice"));
+        }
+        seen[k] = true;
+        let v: f64 = value
+            .trim()
+            .parse()
+            .map_err(|_| format!("\"{}\" is not a number", value.trim()))?;
+        if !v.is_finite() {
+            return Err(format!("{name} = {v} is not finite"));
+        }
+        e[k] = v;
+    }
+    if !seen.iter().any(|&s| s) {
+        return Err("no strain component given (e.g. e11=0.02)".into());
+    }
+    Ok(e)
+}
+
 /// The 6×6 matrix M(x) with (u, θ)(x) = M(x) E at the point (x, y, z) (relative coordinates).
 pub fn macro_matrix(x: f64, y: f64, z: f64) -> SMatrix<f64, 6, 6> {
     let mut m = SMatrix::<f64, 6, 6>::zeros();
@@ -44,6 +76,26 @@ pub fn macro_matrix(x: f64, y: f64, z: f64) -> SMatrix<f64, 6, 6> {
 mod tests {
     use super::*;
     use nalgebra::SVector;
+
+    #[test]
+    fn strain_strings_parse_or_name_the_fault() {
+        assert_eq!(
+            parse_macro_strain("e11=0.02, k12 = -3").unwrap(),
+            [0.02, 0.0, 0.0, 0.0, 0.0, -3.0]
+        );
+        for (bad, says) in [
+            ("e11", "not name=value"),
+            ("e33=1", "unknown strain component \"e33\""),
+            ("e11=abc", "not a number"),
+            ("e11=NaN", "not finite"),
+            ("e11=inf", "not finite"),
+            ("e11=1,e11=2", "given twice"),
+            ("", "no strain component"),
+        ] {
+            let e = parse_macro_strain(bad).unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
 
     #[test]
     fn rotations_are_the_curl_of_the_displacement_field() {

@@ -5,6 +5,6 @@ mod macro_field;
 mod pairing;
 mod percolation;
 
-pub use macro_field::{macro_matrix, MacroStrain, MACRO_NAMES};
+pub use macro_field::{macro_matrix, parse_macro_strain, MacroStrain, MACRO_NAMES};
 pub use pairing::{anchor_node, pair_boundary_nodes, CellError, CellGeometry, Periodicity};
 pub use percolation::check_percolation;

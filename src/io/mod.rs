@@ -1,8 +1,9 @@
 //! Files: the native model format (TOML and JSON, one schema), Abaqus `.inp` import, results
-//! (CSV, JSON), VTK `.vtu` and Matrix Market output. Outputs are written atomically.
+//! (CSV, JSON), VTK `.vtu`, Matrix Market output and plots (SVG, PNG). Outputs are written atomically.
 
 mod abaqus;
 mod atomic;
+mod curve_files;
 mod error;
 mod matrix_market;
 mod native;
@@ -12,10 +13,14 @@ mod vtk;
 
 pub use abaqus::parse_abaqus;
 pub use atomic::write_atomic;
+pub use curve_files::{
+    curve_csv, curve_plot, dominant_component, switches_csv, write_curve_files, RESULTANT_NAMES,
+    RESULTANT_UNITS,
+};
 pub use error::InputError;
 pub use matrix_market::write_matrix_market;
 pub use native::{parse_json, parse_toml, to_json, to_toml};
-pub use plot::{line_plot_svg, Series};
+pub use plot::{LinePlot, Series, PLOT_SIZE};
 pub use results::{
     contacts_csv, displacements_csv, incremental_json, increments_csv, solution_json,
 };

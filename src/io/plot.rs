@@ -1,146 +1,256 @@
-//! A small SVG line plot for stress–strain curves (hand-written: plotting crates need system
-//! fonts for text layout, which the default build must not require).
+//! Line plots (stress–strain curves) as SVG and PNG, drawn once with plotters for both
+//! backends. Text is laid out with the embedded DejaVu Sans font, so no system fonts are needed.
 
-use std::fmt::Write;
+use crate::Error;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::sync::Once;
 
-/// A curve to draw: points, colour and legend label.
+/// A curve to draw.
+#[derive(Clone, Debug)]
 pub struct Series<'a> {
     /// (x, y) points in order.
     pub points: &'a [(f64, f64)],
-    /// SVG colour.
-    pub colour: &'a str,
+    /// RGB colour.
+    pub colour: (u8, u8, u8),
     /// Legend text.
     pub label: &'a str,
 }
 
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
+/// A line plot: series, circled markers, axis labels.
+#[derive(Clone, Debug)]
+pub struct LinePlot<'a> {
+    /// Title above the plot.
+    pub title: &'a str,
+    /// Horizontal axis label.
+    pub x_label: &'a str,
+    /// Vertical axis label.
+    pub y_label: &'a str,
+    /// The curves.
+    pub series: &'a [Series<'a>],
+    /// Points to circle (e.g. contact switches), with their legend label.
+    pub markers: &'a [(f64, f64)],
+    /// Legend label of the markers.
+    pub marker_label: &'a str,
 }
 
-/// An SVG document with the series, circles at `markers`, axis labels and min/max ticks.
-pub fn line_plot_svg(
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    series: &[Series<'_>],
-    markers: &[(f64, f64)],
-) -> String {
-    let (w, h, left, right, top, bottom) = (720.0, 480.0, 90.0, 20.0, 40.0, 60.0);
-    let all = series
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .chain(markers.iter());
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in all.filter(|p| p.0.is_finite() && p.1.is_finite()) {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
+/// Size of the rendered plot (pixels; SVG user units).
+pub const PLOT_SIZE: (u32, u32) = (800, 540);
+
+const FONT: &str = "sans-serif";
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The embedded font is a valid TrueType file; a failure would only drop the text.
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
+    });
+}
+
+fn plot_error(what: &str, e: impl std::fmt::Display) -> Error {
+    Error::Output {
+        path: what.to_string(),
+        message: e.to_string(),
     }
-    if !(x0 < x1) {
-        (x0, x1) = (x0.min(0.0) - 1.0, x1.max(0.0) + 1.0);
+}
+
+impl LinePlot<'_> {
+    /// The plot as an SVG document.
+    pub fn svg(&self) -> Result<String, Error> {
+        register_font();
+        let mut s = String::new();
+        {
+            let root = SVGBackend::with_string(&mut s, PLOT_SIZE).into_drawing_area();
+            self.draw(&root).map_err(|e| plot_error("svg plot", e))?;
+            root.present().map_err(|e| plot_error("svg plot", e))?;
+        }
+        Ok(s)
     }
-    if !(y0 < y1) {
-        (y0, y1) = (y0.min(0.0) - 1.0, y1.max(0.0) + 1.0);
+
+    /// The plot as a PNG image (8-bit RGB).
+    pub fn png(&self) -> Result<Vec<u8>, Error> {
+        register_font();
+        let (w, h) = PLOT_SIZE;
+        let mut rgb = vec![0u8; (w * h * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, PLOT_SIZE).into_drawing_area();
+            self.draw(&root).map_err(|e| plot_error("png plot", e))?;
+            root.present().map_err(|e| plot_error("png plot", e))?;
+        }
+        encode_png(&rgb, w, h)
     }
-    let sx = |x: f64| left + (x - x0) / (x1 - x0) * (w - left - right);
-    let sy = |y: f64| h - bottom - (y - y0) / (y1 - y0) * (h - top - bottom);
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="13">"#
-    );
-    let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="24" text-anchor="middle" font-size="15">{}</text>"#,
-        w / 2.0,
-        escape(title)
-    );
-    let (ax, ay) = (sx(x0), sy(y0));
-    let _ = writeln!(
-        s,
-        r#"<path d="M{ax},{} L{ax},{ay} L{},{ay}" stroke="black" fill="none"/>"#,
-        sy(y1),
-        sx(x1)
-    );
-    if y0 < 0.0 && y1 > 0.0 {
-        let _ = writeln!(
-            s,
-            r#"<line x1="{ax}" y1="{z}" x2="{}" y2="{z}" stroke="gray" stroke-dasharray="4 3"/>"#,
-            sx(x1),
-            z = sy(0.0)
-        );
-    }
-    for (v, anchor) in [(x0, "start"), (x1, "end")] {
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="{anchor}">{v:.3e}</text>"#,
-            sx(v),
-            ay + 18.0
-        );
-    }
-    for v in [y0, y1] {
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="end">{v:.3e}</text>"#,
-            ax - 6.0,
-            sy(v) + 4.0
-        );
-    }
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
-        (ax + sx(x1)) / 2.0,
-        h - 15.0,
-        escape(x_label)
-    );
-    let _ = writeln!(
-        s,
-        r#"<text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">{}</text>"#,
-        (top + ay) / 2.0,
-        (top + ay) / 2.0,
-        escape(y_label)
-    );
-    for (k, ser) in series.iter().enumerate() {
-        let pts: Vec<String> = ser
-            .points
+
+    fn bounds(&self) -> ((f64, f64), (f64, f64)) {
+        let (mut x0, mut x1, mut y0, mut y1) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        let all = self
+            .series
             .iter()
-            .map(|&(x, y)| format!("{:.2},{:.2}", sx(x), sy(y)))
-            .collect();
-        let _ = writeln!(
-            s,
-            r#"<polyline points="{}" fill="none" stroke="{}" stroke-width="2"/>"#,
-            pts.join(" "),
-            ser.colour
+            .flat_map(|s| s.points.iter())
+            .chain(self.markers.iter());
+        for &(x, y) in all.filter(|p| p.0.is_finite() && p.1.is_finite()) {
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+        }
+        let pad = |a: f64, b: f64| {
+            let d = if b > a { 0.05 * (b - a) } else { 1.0 };
+            (a - d, b + d)
+        };
+        (pad(x0, x1), pad(y0, y1))
+    }
+
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        root.fill(&WHITE)?;
+        let ((x0, x1), (y0, y1)) = self.bounds();
+        let mut chart = ChartBuilder::on(root)
+            .caption(self.title, (FONT, 18))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x0..x1, y0..y1)?;
+        chart
+            .configure_mesh()
+            .x_desc(self.x_label)
+            .y_desc(self.y_label)
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .light_line_style(WHITE.mix(0.0))
+            .draw()?;
+        for s in self.series {
+            let colour = RGBColor(s.colour.0, s.colour.1, s.colour.2);
+            chart
+                .draw_series(LineSeries::new(
+                    s.points
+                        .iter()
+                        .copied()
+                        .filter(|p| p.0.is_finite() && p.1.is_finite()),
+                    colour.stroke_width(2),
+                ))?
+                .label(s.label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(2))
+                });
+        }
+        if !self.markers.is_empty() {
+            let crimson = RGBColor(220, 20, 60);
+            chart
+                .draw_series(
+                    self.markers
+                        .iter()
+                        .map(|&p| Circle::new(p, 6, crimson.stroke_width(2))),
+                )?
+                .label(self.marker_label)
+                .legend(move |(x, y)| Circle::new((x + 12, y), 5, crimson.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 13))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
+        Ok(())
+    }
+}
+
+/// An axis tick: plain decimals between 10⁻² and 10⁴, otherwise scientific; trailing zeros cut.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if a < 1e-300 {
+        return "0".into();
+    }
+    let trim = |s: String| -> String {
+        match s.split_once('e') {
+            Some((m, e)) if m.contains('.') => {
+                format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+            }
+            None if s.contains('.') => s.trim_end_matches('0').trim_end_matches('.').into(),
+            _ => s,
+        }
+    };
+    if (1e-2..1e4).contains(&a) {
+        trim(format!("{v:.4}"))
+    } else {
+        trim(format!("{v:.3e}"))
+    }
+}
+
+/// Encodes 8-bit RGB pixels as PNG.
+pub(crate) fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, Error> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().map_err(|e| plot_error("png", e))?;
+        w.write_image_data(rgb).map_err(|e| plot_error("png", e))?;
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plot<'a>(series: &'a [Series<'a>], markers: &'a [(f64, f64)]) -> LinePlot<'a> {
+        LinePlot {
+            title: "t <&>",
+            x_label: "e11",
+            y_label: "N11 (N/m)",
+            series,
+            markers,
+            marker_label: "switch to slip",
+        }
+    }
+
+    #[test]
+    fn svg_and_png_hold_the_plot() {
+        let pts = [(0.0, 0.0), (0.01, 2.0), (0.02, 3.0)];
+        let series = [Series {
+            points: &pts,
+            colour: (70, 130, 180),
+            label: "cell",
+        }];
+        let p = plot(&series, &[(0.01, 2.0)]);
+        let svg = p.svg().unwrap();
+        assert!(
+            svg.starts_with("<svg") && svg.contains("N11 (N/m)") && svg.contains("&lt;&amp;&gt;")
         );
-        let ly = top + 10.0 + 18.0 * k as f64;
-        let _ = writeln!(
-            s,
-            r#"<line x1="{}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="2"/><text x="{}" y="{}">{}</text>"#,
-            left + 10.0,
-            left + 35.0,
-            ser.colour,
-            left + 40.0,
-            ly + 4.0,
-            escape(ser.label)
+        assert!(svg.contains("<circle"), "the marker is drawn");
+        let png = p.png().unwrap();
+        assert_eq!(&png[1..4], b"PNG");
+        // IHDR: width and height, big-endian, after the 8-byte signature and 8-byte chunk head.
+        assert_eq!(
+            u32::from_be_bytes([png[16], png[17], png[18], png[19]]),
+            PLOT_SIZE.0
+        );
+        assert_eq!(
+            u32::from_be_bytes([png[20], png[21], png[22], png[23]]),
+            PLOT_SIZE.1
         );
     }
-    for &(x, y) in markers {
-        let _ = writeln!(
-            s,
-            r#"<circle cx="{:.2}" cy="{:.2}" r="5" fill="none" stroke="crimson" stroke-width="2"/>"#,
-            sx(x),
-            sy(y)
-        );
+
+    #[test]
+    fn ticks_are_short() {
+        assert_eq!(tick(0.0), "0");
+        assert_eq!(tick(2.5), "2.5");
+        assert_eq!(tick(-0.125), "-0.125");
+        assert_eq!(tick(0.002), "2e-3");
+        assert_eq!(tick(1.25e5), "1.25e5");
     }
-    s.push_str("</svg>\n");
-    s
+
+    #[test]
+    fn degenerate_and_non_finite_data_still_plot() {
+        let pts = [(0.0, 0.0), (f64::NAN, 1.0)];
+        let series = [Series {
+            points: &pts,
+            colour: (0, 0, 0),
+            label: "flat",
+        }];
+        assert!(plot(&series, &[]).svg().is_ok());
+        assert!(plot(&[], &[]).png().is_ok());
+    }
 }
