@@ -30,6 +30,7 @@ pub mod homogenize;
 pub mod io;
 pub mod model;
 pub mod solve;
+pub mod stats;
 
 pub use error::Error;
 pub use fibercell_solver as solver;

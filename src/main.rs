@@ -85,6 +85,19 @@ enum Command {
         #[arg(short, long, default_value = "fibercell-results")]
         output: PathBuf,
     },
+    /// Generate a periodic fabric cell and print its statistics.
+    Generate {
+        #[command(subcommand)]
+        kind: GenerateKind,
+    },
+    /// Statistics of a model: fibers, length, volume fraction, orientation tensor, contacts.
+    Stats {
+        /// Model file.
+        model: PathBuf,
+        /// Print one JSON document.
+        #[arg(long)]
+        json: bool,
+    },
     /// Write the reduced stiffness matrix in Matrix Market form (symmetric, lower triangle).
     ExportMatrix {
         /// Model file.
@@ -93,6 +106,95 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+}
+
+#[derive(Subcommand)]
+enum GenerateKind {
+    /// A stochastic non-woven: fibers deposited one on another (see the README).
+    Nonwoven {
+        /// All parameters from a TOML file (the fields of `generate::NonWoven`); the flags
+        /// below override it.
+        #[arg(long, conflicts_with = "preset")]
+        params: Option<PathBuf>,
+        /// Start from a benchmark cell: S, M or L (see the README).
+        #[arg(long)]
+        preset: Option<String>,
+        /// Cell periods Lx,Ly (m).
+        #[arg(long, value_parser = parse_pair)]
+        size: Option<[f64; 2]>,
+        /// Number of fibers.
+        #[arg(long, conflicts_with = "volume_fraction")]
+        fibers: Option<usize>,
+        /// Solid volume fraction with --thickness instead of --fibers.
+        #[arg(long, requires = "thickness")]
+        volume_fraction: Option<f64>,
+        /// Nominal thickness (m) for --volume-fraction.
+        #[arg(long)]
+        thickness: Option<f64>,
+        /// Mean fiber length (m).
+        #[arg(long)]
+        length: Option<f64>,
+        /// Coefficient of variation of the (log-normal) length; 0: all equal.
+        #[arg(long)]
+        length_cv: Option<f64>,
+        /// Fiber radius (m).
+        #[arg(long)]
+        radius: Option<f64>,
+        /// isotropic, tensor:A11,A12 or vonmises:ANGLE,KAPPA (angle in degrees).
+        #[arg(long, value_parser = parse_orientation)]
+        orientation: Option<fibercell::generate::Orientation>,
+        /// Largest out-of-plane tilt (degrees).
+        #[arg(long)]
+        tilt: Option<f64>,
+        /// In-plane curvature of the fibers (1/m).
+        #[arg(long)]
+        curl: Option<f64>,
+        /// Largest element length (m).
+        #[arg(long)]
+        element_length: Option<f64>,
+        /// Random seed.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Output model (.toml or .json).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+}
+
+fn parse_pair(s: &str) -> Result<[f64; 2], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| {
+            p.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("\"{p}\" is not a number"))
+        })
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [a, b] => Ok([*a, *b]),
+        _ => Err(format!("\"{s}\" is not two comma-separated numbers")),
+    }
+}
+
+fn parse_orientation(s: &str) -> Result<fibercell::generate::Orientation, String> {
+    use fibercell::generate::Orientation;
+    match s.split_once(':') {
+        None if s == "isotropic" => Ok(Orientation::Isotropic),
+        Some(("tensor", v)) => {
+            let [a11, a12] = parse_pair(v)?;
+            Ok(Orientation::Tensor { a11, a12 })
+        }
+        Some(("vonmises", v)) => {
+            let [angle, kappa] = parse_pair(v)?;
+            Ok(Orientation::VonMises {
+                mean_angle: angle.to_radians(),
+                concentration: kappa,
+            })
+        }
+        _ => Err(format!(
+            "unknown orientation \"{s}\" (use isotropic, tensor:A11,A12 or vonmises:ANGLE,KAPPA)"
+        )),
+    }
 }
 
 fn parse_solver(s: &str) -> Result<SolverKind, String> {
@@ -442,6 +544,136 @@ fn curve(
     Ok(())
 }
 
+fn write_model(path: &Path, d: &fibercell::model::ModelDescription) -> Result<(), Error> {
+    let text = match path.extension().and_then(|e| e.to_str()) {
+        Some("json") => io::to_json(d),
+        Some("toml") => io::to_toml(d),
+        _ => {
+            return Err(Error::InvalidOption(format!(
+                "{}: the output must be a .toml or .json file",
+                path.display()
+            )))
+        }
+    }
+    .map_err(|message| Error::Output {
+        path: path.display().to_string(),
+        message,
+    })?;
+    write(path, &text)
+}
+
+fn generate(kind: GenerateKind) -> Result<(), Error> {
+    use fibercell::generate::{FiberAmount, LengthDistribution, NonWoven};
+    match kind {
+        GenerateKind::Nonwoven {
+            params,
+            preset,
+            size,
+            fibers,
+            volume_fraction,
+            thickness,
+            length,
+            length_cv,
+            radius,
+            orientation,
+            tilt,
+            curl,
+            element_length,
+            seed,
+            output,
+        } => {
+            let mut p = match params {
+                Some(path) => {
+                    let text = std::fs::read_to_string(&path)
+                        .map_err(|e| Error::InvalidOption(format!("{}: {e}", path.display())))?;
+                    toml::from_str::<NonWoven>(&text).map_err(|e| {
+                        Error::InvalidOption(format!("{}: {}", path.display(), e.message()))
+                    })?
+                }
+                None => match preset {
+                    Some(name) => fibercell::generate::nonwoven_preset(&name, 1)?,
+                    None => NonWoven::default(),
+                },
+            };
+            if let Some(v) = size {
+                p.size = v;
+            }
+            if let Some(fibers) = fibers {
+                p.amount = FiberAmount::Count { fibers };
+            }
+            if let (Some(fraction), Some(thickness)) = (volume_fraction, thickness) {
+                p.amount = FiberAmount::VolumeFraction {
+                    fraction,
+                    thickness,
+                };
+            }
+            if length.is_some() || length_cv.is_some() {
+                let mean = length.unwrap_or(match p.length {
+                    LengthDistribution::Fixed { length } => length,
+                    LengthDistribution::LogNormal { mean, .. } => mean,
+                });
+                p.length = match length_cv {
+                    Some(cv) if cv > 0.0 => LengthDistribution::LogNormal { mean, cv },
+                    _ => LengthDistribution::Fixed { length: mean },
+                };
+            }
+            if let Some(v) = radius {
+                p.radius = v;
+            }
+            if let Some(v) = orientation {
+                p.orientation = v;
+            }
+            if let Some(v) = tilt {
+                p.tilt = v.to_radians();
+            }
+            if let Some(v) = curl {
+                p.curl = v;
+            }
+            if let Some(v) = element_length {
+                p.element_length = v;
+            }
+            if let Some(v) = seed {
+                p.seed = v;
+            }
+            let t = std::time::Instant::now();
+            let cell = fibercell::generate::nonwoven(&p)?;
+            let elapsed = t.elapsed().as_secs_f64();
+            write_model(&output, &cell.description)?;
+            let model = fibercell::Model::from_description(&cell.description)?;
+            let stats = fibercell::stats::network_stats(&model)?;
+            let r = &cell.report;
+            println!(
+                "non-woven (seed {}): {} fibers deposited in {:.2} s, {} dropped (touching nothing), {} supports; written to {}",
+                p.seed,
+                r.deposited,
+                elapsed,
+                r.dropped,
+                r.supports,
+                output.display()
+            );
+            println!("{}", stats.summary());
+            Ok(())
+        }
+    }
+}
+
+fn stats(model_path: &Path, json: bool) -> Result<(), Error> {
+    let model = io::load_model(model_path)?;
+    let s = fibercell::stats::network_stats(&model)?;
+    if json {
+        println!(
+            "{}",
+            to_pretty(&serde_json::to_value(&s).map_err(|e| Error::Output {
+                path: "json".into(),
+                message: e.to_string(),
+            })?)?
+        );
+    } else {
+        println!("{}: {}", model_path.display(), s.summary());
+    }
+    Ok(())
+}
+
 fn export_matrix(model_path: &Path, out: &Path) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
     let sys = fibercell::solve::ReducedSystem::assemble(&model, Default::default())?;
@@ -493,6 +725,8 @@ fn main() -> ExitCode {
             json,
             output,
         } => curve(&model, (strain, steps, unload), solver, json, &output),
+        Command::Generate { kind } => generate(kind),
+        Command::Stats { model, json } => stats(&model, json),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
     };
     match r {

@@ -17,6 +17,14 @@ fn tmpdir(name: &str) -> std::path::PathBuf {
     d
 }
 
+/// The command fails with a non-zero exit and its error contains `needle`.
+fn fails_saying(args: &[&str], needle: &str) {
+    let o = run(args);
+    assert!(!o.status.success(), "{args:?}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains(needle), "{args:?}: {err}");
+}
+
 #[test]
 fn solve_writes_csv_json_vtu_and_prints_json() {
     let out = tmpdir("solve");
@@ -279,12 +287,65 @@ fn curve_writes_csv_switches_json_svg_and_png() {
             "no [cell] section",
         ),
     ] {
-        let o = run(&args);
-        assert!(!o.status.success(), "{args:?}");
-        assert!(
-            String::from_utf8_lossy(&o.stderr).contains(needle),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        fails_saying(&args, needle);
     }
+}
+
+#[test]
+fn generate_nonwoven_writes_a_cell_that_stats_reads() {
+    let out = tmpdir("generate");
+    std::fs::create_dir_all(&out).unwrap();
+    let cell = out.join("nw.toml");
+    let o = run(&[
+        "generate",
+        "nonwoven",
+        "--size",
+        "4e-3,4e-3",
+        "--fibers",
+        "80",
+        "--length",
+        "1.5e-3",
+        "--orientation",
+        "tensor:0.7,0.0",
+        "--seed",
+        "2",
+        "-o",
+        cell.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let printed = String::from_utf8_lossy(&o.stdout);
+    assert!(printed.contains("80 fibers deposited") && printed.contains("contacts"));
+    let o = run(&["stats", cell.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(doc["fibers"], 80);
+    assert!(doc["contacts"].as_u64().unwrap() > 80);
+    for (args, needle) in [
+        (
+            vec!["generate", "nonwoven", "--radius=-1", "-o", "x.toml"],
+            "radius",
+        ),
+        (
+            vec![
+                "generate",
+                "nonwoven",
+                "--orientation",
+                "spiral",
+                "-o",
+                "x.toml",
+            ],
+            "unknown orientation",
+        ),
+        (
+            vec!["generate", "nonwoven", "--preset", "XL", "-o", "x.toml"],
+            "unknown cell size",
+        ),
+        (
+            vec!["generate", "nonwoven", "--fibers", "10", "-o", "x.vtu"],
+            "must be a .toml or .json",
+        ),
+    ] {
+        fails_saying(&args, needle);
+    }
+    assert!(!std::path::Path::new("x.toml").exists() && !std::path::Path::new("x.vtu").exists());
 }

@@ -1,0 +1,183 @@
+//! Statistics of a fiber network: fiber count, total length, solid volume fraction,
+//! orientation tensor, contacts and the mean free segment length between contacts.
+
+use crate::cell::pair_boundary_nodes;
+use crate::contact::ContactSet;
+use crate::model::Model;
+use crate::Error;
+use serde::Serialize;
+
+/// Statistics of a model (a periodic cell, or any network).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NetworkStats {
+    /// Fibers of the model (a fiber cut by the cell faces counts once per piece).
+    pub fiber_pieces: usize,
+    /// Physical fibers: pieces joined end to end through paired boundary nodes count once.
+    pub fibers: usize,
+    /// Elements.
+    pub elements: usize,
+    /// Nodes.
+    pub nodes: usize,
+    /// Total centerline length (m).
+    pub total_length: f64,
+    /// Fiber volume Σ π r² l (m³).
+    pub fiber_volume: f64,
+    /// Cell area L_x L_y (m²), for cells.
+    pub cell_area: Option<f64>,
+    /// Thickness used for the volume fraction (m): the cell's, else the z extent of the fiber
+    /// surfaces.
+    pub thickness: f64,
+    /// z extent of the fiber surfaces (m).
+    pub z_extent: f64,
+    /// Solid volume fraction: fiber volume / (area × thickness), for cells.
+    pub volume_fraction: Option<f64>,
+    /// Length-weighted orientation tensor ⟨t ⊗ t⟩ of the elements: a11, a22, a33, a12, a13, a23.
+    pub orientation: [f64; 6],
+    /// The in-plane tensor of the plan-view directions, normalized: a11, a22, a12.
+    pub orientation_in_plane: [f64; 3],
+    /// Contact pairs the search and the explicit pairs give (within the search tolerance).
+    pub contact_candidates: usize,
+    /// Closed contacts (gap ≤ 0 after the initial-penetration treatment).
+    pub contacts: usize,
+    /// Initially penetrating pairs and the worst overlap (m).
+    pub penetrating: usize,
+    /// The worst initial overlap (m).
+    pub worst_overlap: f64,
+    /// Mean free segment length between contacts, total length / (2 × contacts) (m): every
+    /// contact ends a free segment on each of its two fibers.
+    pub mean_free_segment: Option<f64>,
+    /// Closed contacts per physical fiber, 2 × contacts / fibers.
+    pub contacts_per_fiber: f64,
+}
+
+/// Computes the statistics of `model`; a cell's boundary must pair (the contact search sees
+/// the periodic images).
+pub fn network_stats(model: &Model) -> Result<NetworkStats, Error> {
+    let periodic = match model.cell {
+        Some(_) => Some(pair_boundary_nodes(model)?),
+        None => None,
+    };
+    let mut total_length = 0.0;
+    let mut volume = 0.0;
+    let mut a = [0.0; 6];
+    let mut plan = [0.0; 3];
+    let mut plan_weight = 0.0;
+    let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
+    for el in model.elements() {
+        let f = &model.fibers[el.fiber];
+        let [p, q] = el.nodes.map(|n| model.nodes[n].x);
+        let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        total_length += l;
+        volume += f.section.area() * l;
+        if l > 0.0 {
+            let t = d.map(|v| v / l);
+            for (k, (i, j)) in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)]
+                .into_iter()
+                .enumerate()
+            {
+                a[k] += l * t[i] * t[j];
+            }
+            let lp = (d[0] * d[0] + d[1] * d[1]).sqrt();
+            if lp > 0.0 {
+                plan[0] += d[0] * d[0] / lp;
+                plan[1] += d[1] * d[1] / lp;
+                plan[2] += d[0] * d[1] / lp;
+                plan_weight += lp;
+            }
+        }
+        let r = f.section.radius;
+        zmin = zmin.min(p[2].min(q[2]) - r);
+        zmax = zmax.max(p[2].max(q[2]) + r);
+    }
+    if total_length > 0.0 {
+        a.iter_mut().for_each(|v| *v /= total_length);
+    }
+    if plan_weight > 0.0 {
+        plan.iter_mut().for_each(|v| *v /= plan_weight);
+    }
+    let z_extent = if zmax > zmin { zmax - zmin } else { 0.0 };
+    let cell_area = periodic.as_ref().map(|p| p.geometry.area());
+    let thickness = periodic.as_ref().map_or(z_extent, |p| p.geometry.thickness);
+    let set = ContactSet::build_with(model, periodic.as_ref())?;
+    let contacts = set.pairs.iter().filter(|p| p.gap <= 0.0).count();
+    // Physical fibers: a slave node that ends one piece and whose master ends another joins
+    // the two.
+    let mut ends: Vec<u32> = vec![0; model.nodes.len()];
+    for f in &model.fibers {
+        if let (Some(&a), Some(&b)) = (f.nodes.first(), f.nodes.last()) {
+            ends[a] += 1;
+            ends[b] += 1;
+        }
+    }
+    let joins = periodic.as_ref().map_or(0, |p| {
+        p.master
+            .iter()
+            .enumerate()
+            .filter(|(n, m)| matches!(m, Some((master, _)) if ends[*n] == 1 && ends[*master] == 1))
+            .count()
+    });
+    let fibers = model.fibers.len().saturating_sub(joins);
+    Ok(NetworkStats {
+        fiber_pieces: model.fibers.len(),
+        fibers,
+        elements: model.elements().len(),
+        nodes: model.nodes.len(),
+        total_length,
+        fiber_volume: volume,
+        cell_area,
+        thickness,
+        z_extent,
+        volume_fraction: cell_area
+            .filter(|_| thickness > 0.0)
+            .map(|area| volume / (area * thickness)),
+        orientation: a,
+        orientation_in_plane: plan,
+        contact_candidates: set.pairs.len(),
+        contacts,
+        penetrating: set.penetration.count,
+        worst_overlap: set.penetration.worst_overlap,
+        mean_free_segment: (contacts > 0).then(|| total_length / (2.0 * contacts as f64)),
+        contacts_per_fiber: if fibers > 0 {
+            2.0 * contacts as f64 / fibers as f64
+        } else {
+            0.0
+        },
+    })
+}
+
+impl NetworkStats {
+    /// A few lines for a terminal.
+    pub fn summary(&self) -> String {
+        let mut s = format!(
+            "{} fibers ({} pieces), {} elements, {} nodes; total length {:.4e} m, fiber volume {:.4e} m³\n",
+            self.fibers, self.fiber_pieces, self.elements, self.nodes, self.total_length, self.fiber_volume
+        );
+        if let (Some(area), Some(vf)) = (self.cell_area, self.volume_fraction) {
+            s += &format!(
+                "cell area {:.4e} m², thickness {:.4e} m (fibers span {:.4e} m): solid volume fraction {:.4}\n",
+                area, self.thickness, self.z_extent, vf
+            );
+        }
+        let o = &self.orientation_in_plane;
+        s += &format!(
+            "orientation tensor (plan view) a11 {:.4} a22 {:.4} a12 {:.4}; out of plane a33 {:.2e}\n",
+            o[0], o[1], o[2], self.orientation[2]
+        );
+        s += &format!(
+            "{} contacts ({} candidate pairs, {:.2} per fiber), mean free segment {}",
+            self.contacts,
+            self.contact_candidates,
+            self.contacts_per_fiber,
+            self.mean_free_segment
+                .map_or("-".into(), |l| format!("{l:.4e} m"))
+        );
+        if self.penetrating > 0 {
+            s += &format!(
+                "\n{} pairs start penetrating, worst overlap {:.3e} m",
+                self.penetrating, self.worst_overlap
+            );
+        }
+        s
+    }
+}
