@@ -97,6 +97,9 @@ enum Command {
         /// Print one JSON document.
         #[arg(long)]
         json: bool,
+        /// Also draw the orientation rose (18 bins of 10°) to PREFIX.svg and PREFIX.png.
+        #[arg(long, value_name = "PREFIX")]
+        rose: Option<PathBuf>,
     },
     /// Write the reduced stiffness matrix in Matrix Market form (symmetric, lower triangle).
     ExportMatrix {
@@ -657,9 +660,23 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
     }
 }
 
-fn stats(model_path: &Path, json: bool) -> Result<(), Error> {
+fn stats(model_path: &Path, json: bool, rose: Option<&Path>) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
     let s = fibercell::stats::network_stats(&model)?;
+    if let Some(prefix) = rose {
+        let fractions = fibercell::stats::orientation_histogram(&model, 18);
+        let title = format!(
+            "{}: fiber orientation (length-weighted)",
+            model_path.display()
+        );
+        let plot = io::RosePlot {
+            title: &title,
+            fractions: &fractions,
+        };
+        let (svg, png) = (plot.svg()?, plot.png()?);
+        io::write_atomic(&prefix.with_extension("svg"), svg.as_bytes())?;
+        io::write_atomic(&prefix.with_extension("png"), &png)?;
+    }
     if json {
         println!(
             "{}",
@@ -726,7 +743,7 @@ fn main() -> ExitCode {
             output,
         } => curve(&model, (strain, steps, unload), solver, json, &output),
         Command::Generate { kind } => generate(kind),
-        Command::Stats { model, json } => stats(&model, json),
+        Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
     };
     match r {

@@ -146,6 +146,28 @@ pub fn network_stats(model: &Model) -> Result<NetworkStats, Error> {
     })
 }
 
+/// Length-weighted histogram of the plan-view fiber angle θ ∈ [0, π) (axial: θ and θ + π are
+/// one direction) in `bins` equal bins; the fractions sum to 1 (all zero without plan length).
+pub fn orientation_histogram(model: &Model, bins: usize) -> Vec<f64> {
+    let bins = bins.max(1);
+    let mut h = vec![0.0; bins];
+    for el in model.elements() {
+        let [p, q] = el.nodes.map(|n| model.nodes[n].x);
+        let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+        let l = (dx * dx + dy * dy).sqrt();
+        if l > 0.0 {
+            let theta = dy.atan2(dx).rem_euclid(std::f64::consts::PI);
+            let k = ((theta / std::f64::consts::PI * bins as f64) as usize).min(bins - 1);
+            h[k] += l;
+        }
+    }
+    let total: f64 = h.iter().sum();
+    if total > 0.0 {
+        h.iter_mut().for_each(|v| *v /= total);
+    }
+    h
+}
+
 impl NetworkStats {
     /// A few lines for a terminal.
     pub fn summary(&self) -> String {
@@ -179,5 +201,61 @@ impl NetworkStats {
             );
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{FiberSpec, MaterialSpec, ModelDescription, NodeSpec};
+
+    #[test]
+    fn histogram_and_tensor_of_a_cross() {
+        // A fiber of length 2 along x and one of length 1 along y (−y direction: same axis).
+        let nodes = [
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [0.5, 1.0, 0.0],
+            [0.5, 0.0, 0.0],
+        ];
+        let d = ModelDescription {
+            materials: vec![MaterialSpec {
+                name: "m".into(),
+                young: 1.0,
+                poisson: Some(0.3),
+                shear: None,
+            }],
+            nodes: nodes
+                .iter()
+                .enumerate()
+                .map(|(k, &x)| NodeSpec {
+                    id: k as u64 + 1,
+                    x,
+                })
+                .collect(),
+            fibers: vec![
+                FiberSpec {
+                    id: 1,
+                    nodes: vec![1, 2],
+                    radius: 0.01,
+                    material: "m".into(),
+                },
+                FiberSpec {
+                    id: 2,
+                    nodes: vec![3, 4],
+                    radius: 0.01,
+                    material: "m".into(),
+                },
+            ],
+            ..Default::default()
+        };
+        let m = Model::from_description(&d).unwrap();
+        let h = orientation_histogram(&m, 4);
+        assert_eq!(h, vec![2.0 / 3.0, 0.0, 1.0 / 3.0, 0.0]);
+        let s = network_stats(&m).unwrap();
+        assert!((s.total_length - 3.0).abs() < 1e-15);
+        assert!((s.orientation_in_plane[0] - 2.0 / 3.0).abs() < 1e-15);
+        assert!(s.orientation_in_plane[2].abs() < 1e-15);
+        assert_eq!((s.fibers, s.contacts, s.volume_fraction), (2, 0, None));
     }
 }

@@ -315,7 +315,15 @@ fn generate_nonwoven_writes_a_cell_that_stats_reads() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let printed = String::from_utf8_lossy(&o.stdout);
     assert!(printed.contains("80 fibers deposited") && printed.contains("contacts"));
-    let o = run(&["stats", cell.to_str().unwrap(), "--json"]);
+    let rose = out.join("rose");
+    let o = run(&[
+        "stats",
+        cell.to_str().unwrap(),
+        "--json",
+        "--rose",
+        rose.to_str().unwrap(),
+    ]);
+    assert!(out.join("rose.svg").exists() && out.join("rose.png").exists());
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(doc["fibers"], 80);

@@ -20,7 +20,7 @@ pub use curve_files::{
 pub use error::InputError;
 pub use matrix_market::write_matrix_market;
 pub use native::{parse_json, parse_toml, to_json, to_toml};
-pub use plot::{LinePlot, Series, PLOT_SIZE};
+pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};
 pub use results::{
     contacts_csv, displacements_csv, incremental_json, increments_csv, solution_json,
 };

@@ -47,6 +47,39 @@ fn register_font() {
     });
 }
 
+/// Something plotters draws, on any backend.
+trait Drawing {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>;
+}
+
+/// Renders to an SVG document of `size`.
+fn render_svg(d: &impl Drawing, size: (u32, u32)) -> Result<String, Error> {
+    register_font();
+    let mut s = String::new();
+    {
+        let root = SVGBackend::with_string(&mut s, size).into_drawing_area();
+        d.draw(&root).map_err(|e| plot_error("svg plot", e))?;
+        root.present().map_err(|e| plot_error("svg plot", e))?;
+    }
+    Ok(s)
+}
+
+/// Renders to a PNG image of `size`.
+fn render_png(d: &impl Drawing, size: (u32, u32)) -> Result<Vec<u8>, Error> {
+    register_font();
+    let (w, h) = size;
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        d.draw(&root).map_err(|e| plot_error("png plot", e))?;
+        root.present().map_err(|e| plot_error("png plot", e))?;
+    }
+    encode_png(&rgb, w, h)
+}
+
 fn plot_error(what: &str, e: impl std::fmt::Display) -> Error {
     Error::Output {
         path: what.to_string(),
@@ -57,27 +90,12 @@ fn plot_error(what: &str, e: impl std::fmt::Display) -> Error {
 impl LinePlot<'_> {
     /// The plot as an SVG document.
     pub fn svg(&self) -> Result<String, Error> {
-        register_font();
-        let mut s = String::new();
-        {
-            let root = SVGBackend::with_string(&mut s, PLOT_SIZE).into_drawing_area();
-            self.draw(&root).map_err(|e| plot_error("svg plot", e))?;
-            root.present().map_err(|e| plot_error("svg plot", e))?;
-        }
-        Ok(s)
+        render_svg(self, PLOT_SIZE)
     }
 
     /// The plot as a PNG image (8-bit RGB).
     pub fn png(&self) -> Result<Vec<u8>, Error> {
-        register_font();
-        let (w, h) = PLOT_SIZE;
-        let mut rgb = vec![0u8; (w * h * 3) as usize];
-        {
-            let root = BitMapBackend::with_buffer(&mut rgb, PLOT_SIZE).into_drawing_area();
-            self.draw(&root).map_err(|e| plot_error("png plot", e))?;
-            root.present().map_err(|e| plot_error("png plot", e))?;
-        }
-        encode_png(&rgb, w, h)
+        render_png(self, PLOT_SIZE)
     }
 
     fn bounds(&self) -> ((f64, f64), (f64, f64)) {
@@ -96,7 +114,9 @@ impl LinePlot<'_> {
         };
         (pad(x0, x1), pad(y0, y1))
     }
+}
 
+impl Drawing for LinePlot<'_> {
     fn draw<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
@@ -155,6 +175,103 @@ impl LinePlot<'_> {
         Ok(())
     }
 }
+
+/// An orientation rose: the length fraction of each angle bin over [0, π) drawn as a sector
+/// of radius ∝ fraction, mirrored to [π, 2π) (fibers are axial).
+#[derive(Clone, Debug)]
+pub struct RosePlot<'a> {
+    /// Title above the rose.
+    pub title: &'a str,
+    /// Fractions per bin over [0, π).
+    pub fractions: &'a [f64],
+}
+
+impl RosePlot<'_> {
+    /// The rose as an SVG document.
+    pub fn svg(&self) -> Result<String, Error> {
+        render_svg(self, ROSE_SIZE)
+    }
+
+    /// The rose as a PNG image (8-bit RGB).
+    pub fn png(&self) -> Result<Vec<u8>, Error> {
+        render_png(self, ROSE_SIZE)
+    }
+}
+
+impl Drawing for RosePlot<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        use std::f64::consts::PI;
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(root)
+            .caption(self.title, (FONT, 16))
+            .margin(12)
+            .build_cartesian_2d(-1.15..1.15, -1.15..1.15)?;
+        let n = self.fractions.len().max(1);
+        let peak = self.fractions.iter().cloned().fold(0.0, f64::max);
+        let grey = RGBColor(200, 200, 200);
+        for ring in [0.25, 0.5, 0.75, 1.0] {
+            let pts: Vec<(f64, f64)> = (0..=72)
+                .map(|k| {
+                    let a = 2.0 * PI * k as f64 / 72.0;
+                    (ring * a.cos(), ring * a.sin())
+                })
+                .collect();
+            chart.draw_series(std::iter::once(PathElement::new(pts, grey)))?;
+        }
+        for (a, label) in [
+            (0.0, "0°"),
+            (0.5 * PI, "90°"),
+            (PI, "180°"),
+            (1.5 * PI, "270°"),
+        ] {
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![(0.0, 0.0), (a.cos(), a.sin())],
+                grey,
+            )))?;
+            chart.draw_series(std::iter::once(Text::new(
+                label,
+                (1.07 * a.cos() - 0.04, 1.07 * a.sin() + 0.02),
+                (FONT, 13),
+            )))?;
+        }
+        let fill = RGBColor(70, 130, 180);
+        for (k, &f) in self.fractions.iter().enumerate() {
+            if !(f > 0.0) || !(peak > 0.0) {
+                continue;
+            }
+            let r = f / peak;
+            for half in [0.0, PI] {
+                let (a0, a1) = (
+                    half + PI * k as f64 / n as f64,
+                    half + PI * (k + 1) as f64 / n as f64,
+                );
+                let mut pts = vec![(0.0, 0.0)];
+                for j in 0..=8 {
+                    let a = a0 + (a1 - a0) * j as f64 / 8.0;
+                    pts.push((r * a.cos(), r * a.sin()));
+                }
+                chart.draw_series(std::iter::once(Polygon::new(pts.clone(), fill.mix(0.75))))?;
+                pts.push((0.0, 0.0));
+                chart.draw_series(std::iter::once(PathElement::new(
+                    pts,
+                    BLACK.stroke_width(1),
+                )))?;
+            }
+        }
+        chart.draw_series(std::iter::once(Text::new(
+            format!("outer ring: {:.1} % of the length per bin", 100.0 * peak),
+            (-1.1, -1.12),
+            (FONT, 12),
+        )))?;
+        Ok(())
+    }
+}
+
+/// Size of the rose plot (pixels).
+pub const ROSE_SIZE: (u32, u32) = (560, 600);
 
 /// An axis tick: plain decimals between 10⁻² and 10⁴, otherwise scientific; trailing zeros cut.
 fn tick(v: f64) -> String {
@@ -231,6 +348,19 @@ mod tests {
             u32::from_be_bytes([png[20], png[21], png[22], png[23]]),
             PLOT_SIZE.1
         );
+    }
+
+    #[test]
+    fn the_rose_draws_both_halves() {
+        let fr = [0.5, 0.25, 0.25, 0.0];
+        let rose = RosePlot {
+            title: "rose",
+            fractions: &fr,
+        };
+        let svg = rose.svg().unwrap();
+        // Three non-empty bins, each mirrored: six filled sectors.
+        assert_eq!(svg.matches("<polygon").count(), 6, "{svg}");
+        assert_eq!(&rose.png().unwrap()[1..4], b"PNG");
     }
 
     #[test]
