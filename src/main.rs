@@ -241,7 +241,7 @@ fn progress_bar(what: &str) -> (indicatif::ProgressBar, fibercell::solve::Progre
     (bar, report)
 }
 
-fn to_pretty(doc: &serde_json::Value) -> Result<String, Error> {
+fn to_pretty<T: serde::Serialize>(doc: &T) -> Result<String, Error> {
     serde_json::to_string_pretty(doc).map_err(|e| Error::Output {
         path: "json".into(),
         message: e.to_string(),
@@ -410,10 +410,7 @@ fn homogenize(
         ..SolveOptions::default()
     };
     let h = fibercell::homogenize::homogenize_elastic(&model, &options)?;
-    let pretty = to_pretty(&serde_json::to_value(&h).map_err(|e| Error::Output {
-        path: "json".into(),
-        message: e.to_string(),
-    })?)?;
+    let pretty = to_pretty(&h)?;
     if let Some(out) = out {
         std::fs::create_dir_all(out).map_err(|e| Error::Output {
             path: out.display().to_string(),
@@ -507,13 +504,7 @@ fn curve(
     );
     io::write_curve_files(out, &c, &title)?;
     if json {
-        println!(
-            "{}",
-            to_pretty(&serde_json::to_value(&c).map_err(|e| Error::Output {
-                path: "json".into(),
-                message: e.to_string(),
-            })?)?
-        );
+        println!("{}", to_pretty(&c)?);
         return Ok(());
     }
     let k = io::dominant_component(&strain);
@@ -545,24 +536,6 @@ fn curve(
         println!("  … {} switches in all (switches.csv)", c.switches.len());
     }
     Ok(())
-}
-
-fn write_model(path: &Path, d: &fibercell::model::ModelDescription) -> Result<(), Error> {
-    let text = match path.extension().and_then(|e| e.to_str()) {
-        Some("json") => io::to_json(d),
-        Some("toml") => io::to_toml(d),
-        _ => {
-            return Err(Error::InvalidOption(format!(
-                "{}: the output must be a .toml or .json file",
-                path.display()
-            )))
-        }
-    }
-    .map_err(|message| Error::Output {
-        path: path.display().to_string(),
-        message,
-    })?;
-    write(path, &text)
 }
 
 fn generate(kind: GenerateKind) -> Result<(), Error> {
@@ -641,7 +614,7 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             let t = std::time::Instant::now();
             let cell = fibercell::generate::nonwoven(&p)?;
             let elapsed = t.elapsed().as_secs_f64();
-            write_model(&output, &cell.description)?;
+            io::write_description(&output, &cell.description)?;
             let model = fibercell::Model::from_description(&cell.description)?;
             let stats = fibercell::stats::network_stats(&model)?;
             let r = &cell.report;
@@ -678,13 +651,7 @@ fn stats(model_path: &Path, json: bool, rose: Option<&Path>) -> Result<(), Error
         io::write_atomic(&prefix.with_extension("png"), &png)?;
     }
     if json {
-        println!(
-            "{}",
-            to_pretty(&serde_json::to_value(&s).map_err(|e| Error::Output {
-                path: "json".into(),
-                message: e.to_string(),
-            })?)?
-        );
+        println!("{}", to_pretty(&s)?);
     } else {
         println!("{}: {}", model_path.display(), s.summary());
     }

@@ -378,7 +378,6 @@ pub fn nonwoven(params: &NonWoven) -> Result<GeneratedCell, Error> {
         let angle = sample_angle(&mut rng, orient);
         let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
         let tilt = params.tilt * rng.random::<f64>();
-        volume += area * length;
         if length < 4.0 * r {
             break; // the remainder of the target volume is less than a short fiber
         }
@@ -389,7 +388,6 @@ pub fn nonwoven(params: &NonWoven) -> Result<GeneratedCell, Error> {
         };
         let Some(mut stations) = plan_stations(&line, length, params.size, h, min_spacing) else {
             // A corner or an end on a face: redraw.
-            volume -= area * length;
             redraws += 1;
             if redraws > 1000 {
                 return Err(invalid(
@@ -398,10 +396,11 @@ pub fn nonwoven(params: &NonWoven) -> Result<GeneratedCell, Error> {
             }
             continue;
         };
+        volume += area * length;
         redraws = 0;
         touched.push(false);
         // Supports from the deposited segments.
-        let mut supports: Vec<(f64, f64, usize)> = Vec::new();
+        let mut supports: Vec<(f64, f64)> = Vec::new();
         for w in stations.windows(2) {
             let (a, b) = (w[0], w[1]);
             let (pa, pb) = wrap_pair(a.p, b.p, params.size);
@@ -415,35 +414,28 @@ pub fn nonwoven(params: &NonWoven) -> Result<GeneratedCell, Error> {
             );
         }
         report.supports += supports.len();
-        apply_supports(&mut stations, &supports, min_spacing);
+        apply_supports(&mut stations, &mut supports, min_spacing);
         drape(&mut stations, r, tilt);
         // Fill long gaps to the element length (heights interpolated).
         let mut stations = refine(&stations, h);
-        // Lift where the straight elements still penetrate.
-        let passes = lift(&mut stations, &mut grid, params.size, r, tol, &mut near)?;
-        report.max_lift_passes = report.max_lift_passes.max(passes);
-        // Touches and filing.
-        let mut segs = Vec::with_capacity(stations.len());
+        // Lift where the straight elements still penetrate; the last pass, which lifts
+        // nothing, sees the final gaps and names the fibers touched.
+        let lifted = lift(&mut stations, &mut grid, params.size, r, tol, &mut near)?;
+        report.max_lift_passes = report.max_lift_passes.max(lifted.passes);
+        if !lifted.touching.is_empty() {
+            touched[fiber] = true;
+        }
+        for &other in &lifted.touching {
+            touched[other] = true;
+        }
+        // File the new elements.
         for w in stations.windows(2) {
             let (pa, pb) = wrap_pair(w[0].p, w[1].p, params.size);
-            let ends = [[pa[0], pa[1], w[0].z], [pb[0], pb[1], w[1].z]];
-            grid.near(ends, 2.0 * r, &mut near);
-            for &(id, shift) in near.iter() {
-                let t = grid.segments[id];
-                let (g, _, _) = gap_at(ends, r, &t, shift);
-                if g <= 0.0 {
-                    touched[fiber] = true;
-                    touched[t.fiber] = true;
-                }
-            }
-            segs.push(Deposited {
-                ends,
+            grid.insert(Deposited {
+                ends: [[pa[0], pa[1], w[0].z], [pb[0], pb[1], w[1].z]],
                 radius: r,
                 fiber,
             });
-        }
-        for s in segs {
-            grid.insert(s);
         }
         for piece in split_pieces(&stations, params.size) {
             pieces.push((fiber, piece));
@@ -524,33 +516,37 @@ fn plan_stations(
     Some(out)
 }
 
-/// Plan positions of a segment's ends wrapped into the cell together (the first end inside
-/// the box, the second by the same shift; a face station keeps its exact face coordinate).
+/// The periodic cell (i, j) that holds the midpoint of the plan segment a–b: a segment between
+/// two face crossings lies in one cell, whatever roundoff does at its ends.
+fn cell_of(a: [f64; 2], b: [f64; 2], period: [f64; 2]) -> [f64; 2] {
+    [0, 1].map(|k| (0.5 * (a[k] + b[k]) / period[k]).floor())
+}
+
+/// Plan positions of a segment's ends wrapped into the cell together (by the cell of its
+/// midpoint).
 fn wrap_pair(a: [f64; 2], b: [f64; 2], period: [f64; 2]) -> ([f64; 2], [f64; 2]) {
-    let mid = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
-    let shift = [0, 1].map(|k| (mid[k] / period[k]).floor() * period[k]);
+    let cell = cell_of(a, b, period);
+    let shift = [cell[0] * period[0], cell[1] * period[1]];
     (
         [a[0] - shift[0], a[1] - shift[1]],
         [b[0] - shift[0], b[1] - shift[1]],
     )
 }
 
-/// Supports of the plan segment `ends` (arc lengths `s`): (arc length, required height,
-/// supporting fiber).
+/// Supports of the plan segment `ends` (arc lengths `s`): (arc length, required height).
 fn near_supports(
     grid: &mut SegmentGrid,
     ends: [[f64; 2]; 2],
     s: (f64, f64),
     (r, tol): (f64, f64),
     near: &mut Vec<(usize, [f64; 2])>,
-    out: &mut Vec<(f64, f64, usize)>,
+    out: &mut Vec<(f64, f64)>,
 ) {
     let q = [[ends[0][0], ends[0][1], 0.0], [ends[1][0], ends[1][1], 0.0]];
     grid.near(q, 2.0 * r, near);
     for &(id, shift) in near.iter() {
         let t = grid.segments[id];
-        let a = [t.ends[0][0] + shift[0], t.ends[0][1] + shift[1], 0.0];
-        let b = [t.ends[1][0] + shift[0], t.ends[1][1] + shift[1], 0.0];
+        let [a, b] = t.shifted(shift).map(|p| [p[0], p[1], 0.0]);
         let cp = closest_points(&q[0], &q[1], &a, &b);
         let reach = r + t.radius;
         if cp.distance < reach {
@@ -558,7 +554,7 @@ fn near_supports(
             // Touching less half the tolerance: closed for certain, gap −tol/2 (roundoff
             // could leave an exact touch open).
             let need = z + (reach * reach - cp.distance * cp.distance).sqrt() - 0.5 * tol;
-            out.push((s.0 + cp.s * (s.1 - s.0), need, t.fiber));
+            out.push((s.0 + cp.s * (s.1 - s.0), need));
         }
     }
 }
@@ -566,10 +562,9 @@ fn near_supports(
 /// Puts each support on a station: the nearest end, face or support station within
 /// `min_spacing`, or a new support station; a station's required height is the highest of
 /// its supports. Subdivision stations within `min_spacing` of a support are then removed.
-fn apply_supports(stations: &mut Vec<Station>, supports: &[(f64, f64, usize)], min_spacing: f64) {
-    let mut sorted: Vec<(f64, f64)> = supports.iter().map(|s| (s.0, s.1)).collect();
-    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (s, need) in sorted {
+fn apply_supports(stations: &mut Vec<Station>, supports: &mut [(f64, f64)], min_spacing: f64) {
+    supports.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for &(s, need) in supports.iter() {
         let k = stations.partition_point(|st| st.s < s);
         let nearest = (k.saturating_sub(3)..(k + 3).min(stations.len()))
             .filter(|&i| stations[i].kind != Kind::Uniform)
@@ -688,16 +683,7 @@ fn refine(stations: &[Station], h: f64) -> Vec<Station> {
 /// `shift`, the parameter of the closest point along the element, and the vertical component
 /// of the unit normal from the segment to the element.
 fn gap_at(ends: [[f64; 3]; 2], r: f64, t: &Deposited, shift: [f64; 2]) -> (f64, f64, f64) {
-    let a = [
-        t.ends[0][0] + shift[0],
-        t.ends[0][1] + shift[1],
-        t.ends[0][2],
-    ];
-    let b = [
-        t.ends[1][0] + shift[0],
-        t.ends[1][1] + shift[1],
-        t.ends[1][2],
-    ];
+    let [a, b] = t.shifted(shift);
     let cp = closest_points(&ends[0], &ends[1], &a, &b);
     let zp = ends[0][2] + cp.s * (ends[1][2] - ends[0][2]);
     let zq = a[2] + cp.t * (b[2] - a[2]);
@@ -709,8 +695,15 @@ fn gap_at(ends: [[f64; 3]; 2], r: f64, t: &Deposited, shift: [f64; 2]) -> (f64, 
     (cp.distance - (r + t.radius), cp.s, nz)
 }
 
-/// Lifts elements that penetrate deposited segments by more than `tol` until none does;
-/// returns the passes needed.
+/// The outcome of [`lift`].
+struct Lifted {
+    /// Passes over the fiber's elements, the last one lifting nothing.
+    passes: usize,
+    /// Deposited fibers the new one touches (gap ≤ 0) at its final heights (with repeats).
+    touching: Vec<usize>,
+}
+
+/// Lifts elements that penetrate deposited segments by more than `tol` until none does.
 fn lift(
     stations: &mut [Station],
     grid: &mut SegmentGrid,
@@ -718,9 +711,11 @@ fn lift(
     r: f64,
     tol: f64,
     near: &mut Vec<(usize, [f64; 2])>,
-) -> Result<usize, Error> {
+) -> Result<Lifted, Error> {
+    let mut touching = Vec::new();
     for pass in 1..=1000 {
         let mut lifted = false;
+        touching.clear();
         for k in 0..stations.len().saturating_sub(1) {
             let (pa, pb) = wrap_pair(stations[k].p, stations[k + 1].p, period);
             let ends = [
@@ -735,6 +730,9 @@ fn lift(
                 let (g, u, nz) = gap_at(ends, r, &t, shift);
                 if g < -tol && -g > worst.0 {
                     worst = (-g, u, nz);
+                }
+                if g <= 0.0 {
+                    touching.push(t.fiber);
                 }
             }
             if worst.0 > 0.0 {
@@ -752,7 +750,10 @@ fn lift(
             }
         }
         if !lifted {
-            return Ok(pass);
+            return Ok(Lifted {
+                passes: pass,
+                touching,
+            });
         }
     }
     Err(invalid(
@@ -767,10 +768,8 @@ fn split_pieces(stations: &[Station], period: [f64; 2]) -> Vec<Vec<[f64; 3]>> {
     for k in 1..stations.len() {
         if matches!(stations[k].kind, Kind::Face(..)) || k == stations.len() - 1 {
             let run = &stations[start..=k];
-            // The cell image of this run: from the midpoint of its first element.
-            let (a, b) = (run[0].p, run[1].p);
-            let mid = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
-            let cell = [0, 1].map(|i| (mid[i] / period[i]).floor());
+            // The cell image of this run: that of its first element.
+            let cell = cell_of(run[0].p, run[1].p, period);
             let piece = run
                 .iter()
                 .map(|st| {

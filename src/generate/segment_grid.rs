@@ -14,6 +14,13 @@ pub(crate) struct Deposited {
     pub fiber: usize,
 }
 
+impl Deposited {
+    /// The end points of the periodic image shifted by `shift` in the plane.
+    pub fn shifted(&self, shift: [f64; 2]) -> [[f64; 3]; 2] {
+        self.ends.map(|p| [p[0] + shift[0], p[1] + shift[1], p[2]])
+    }
+}
+
 pub(crate) struct SegmentGrid {
     origin: [f64; 2],
     period: [f64; 2],
@@ -25,6 +32,8 @@ pub(crate) struct SegmentGrid {
     /// Query stamp per segment, to report each once.
     seen: Vec<u32>,
     stamp: u32,
+    /// Bins of the current insert or query (reused, no allocation per call).
+    scratch: Vec<usize>,
 }
 
 impl SegmentGrid {
@@ -40,6 +49,7 @@ impl SegmentGrid {
             segments: Vec::new(),
             seen: Vec::new(),
             stamp: 0,
+            scratch: Vec::new(),
         }
     }
 
@@ -51,16 +61,21 @@ impl SegmentGrid {
         (a, b.min(a + self.bins[k] as i64 - 1))
     }
 
-    fn visit(&self, lo: [f64; 2], hi: [f64; 2], mut f: impl FnMut(usize)) {
+    /// The bins the plan-view box [lo, hi] touches, each once, into `self.scratch`.
+    fn collect_bins(&mut self, lo: [f64; 2], hi: [f64; 2]) {
         let (x0, x1) = self.span(0, lo[0], hi[0]);
         let (y0, y1) = self.span(1, lo[1], hi[1]);
+        self.scratch.clear();
         for i in x0..=x1 {
             for j in y0..=y1 {
                 let bi = i.rem_euclid(self.bins[0] as i64) as usize;
                 let bj = j.rem_euclid(self.bins[1] as i64) as usize;
-                f(bi * self.bins[1] + bj);
+                self.scratch.push(bi * self.bins[1] + bj);
             }
         }
+        // A box wider than the cell wraps onto bins it already has.
+        self.scratch.sort_unstable();
+        self.scratch.dedup();
     }
 
     /// Files a segment.
@@ -70,11 +85,8 @@ impl SegmentGrid {
         let pad = s.radius;
         let lo = [p[0].min(q[0]) - pad, p[1].min(q[1]) - pad];
         let hi = [p[0].max(q[0]) + pad, p[1].max(q[1]) + pad];
-        let mut bins = Vec::with_capacity(4);
-        self.visit(lo, hi, |b| bins.push(b));
-        bins.sort_unstable();
-        bins.dedup();
-        for b in bins {
+        self.collect_bins(lo, hi);
+        for &b in &self.scratch {
             self.cells[b].push(id);
         }
         self.segments.push(s);
@@ -95,9 +107,8 @@ impl SegmentGrid {
         let lo = [p[0].min(q[0]) - pad, p[1].min(q[1]) - pad];
         let hi = [p[0].max(q[0]) + pad, p[1].max(q[1]) + pad];
         let mid = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
-        let mut bins = Vec::with_capacity(9);
-        self.visit(lo, hi, |b| bins.push(b));
-        for b in bins {
+        self.collect_bins(lo, hi);
+        for &b in &self.scratch {
             for &id in &self.cells[b] {
                 let id = id as usize;
                 if self.seen[id] == self.stamp {

@@ -4,7 +4,7 @@
 //! switch), the elastic/plastic split (5.5–5.6) and the dissipated energy.
 
 use super::homogenize_elastic;
-use super::segments::{linear_pieces, Segment};
+use super::segments::{linear_pieces, segment_starting_at, Segment};
 use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
 use crate::model::Model;
@@ -169,7 +169,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
     let samples: Vec<(f64, [f64; 6])> = points.iter().map(|p| (p.alpha, p.resultant)).collect();
     let segments = linear_pieces(&samples, &breaks, &turns, &opts.strain);
     for s in &mut switches {
-        if let Some(seg) = segments.iter().find(|g| g.steps[0] == s.step) {
+        if let Some(seg) = segment_starting_at(&segments, s.step) {
             s.estimated_strain = opts.strain.map(|e| seg.alpha[0] * e);
         }
     }

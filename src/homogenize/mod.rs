@@ -14,5 +14,5 @@ pub use curve::{elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEve
 pub use elastic::{homogenize_elastic, Homogenized, PressureResponse};
 pub use orthotropic::{Orthotropic, ThesisModuli};
 pub use pressure::{default_pixel, pressure_load, PressureLoad};
-pub use segments::Segment;
+pub use segments::{segment_starting_at, Segment};
 pub use system::PeriodicSystem;

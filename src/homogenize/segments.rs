@@ -19,6 +19,12 @@ pub struct Segment {
     pub slope: [f64; 6],
 }
 
+/// The piece that starts at increment `step` (pieces are ordered by their first increment).
+pub fn segment_starting_at(segments: &[Segment], step: usize) -> Option<&Segment> {
+    let k = segments.partition_point(|g| g.steps[0] < step);
+    segments.get(k).filter(|g| g.steps[0] == step)
+}
+
 /// A line N(α) = mean + slope (α − alpha_mean), per component.
 #[derive(Clone, Copy)]
 struct Line {

@@ -5,7 +5,7 @@
 use super::plot::{LinePlot, Series};
 use super::write_atomic;
 use crate::cell::MACRO_NAMES;
-use crate::homogenize::Curve;
+use crate::homogenize::{segment_starting_at, Curve};
 use crate::Error;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -79,26 +79,27 @@ pub fn dominant_component(strain: &[f64; 6]) -> usize {
 /// The curve plot: the dominant component of the path against its conjugate resultant, the
 /// all-stick line and the switches to slip. Returns (SVG, PNG).
 pub fn curve_plot(c: &Curve, title: &str) -> Result<(String, Vec<u8>), Error> {
-    let path = c.points.last().map(|p| p.strain).unwrap_or([0.0; 6]);
     let peak = c
         .points
         .iter()
         .max_by(|a, b| a.alpha.abs().total_cmp(&b.alpha.abs()))
-        .map_or(path, |p| p.strain);
+        .map_or([0.0; 6], |p| p.strain);
     let k = dominant_component(&peak);
-    let total: Vec<(f64, f64)> = std::iter::once((0.0, 0.0))
-        .chain(c.points.iter().map(|p| (p.strain[k], p.resultant[k])))
-        .collect();
-    let elastic: Vec<(f64, f64)> = std::iter::once((0.0, 0.0))
-        .chain(c.points.iter().map(|p| (p.strain[k], p.elastic[k])))
-        .collect();
+    // From the unstrained origin along the path.
+    let trace = |value: fn(&crate::homogenize::CurvePoint) -> [f64; 6]| -> Vec<(f64, f64)> {
+        std::iter::once((0.0, 0.0))
+            .chain(c.points.iter().map(|p| (p.strain[k], value(p)[k])))
+            .collect()
+    };
+    let total = trace(|p| p.resultant);
+    let elastic = trace(|p| p.elastic);
     // A switch is marked where the lines of the pieces meet: on the new piece's line.
     let markers: Vec<(f64, f64)> = c
         .switches
         .iter()
         .filter(|s| s.to == "slip")
         .filter_map(|s| {
-            let seg = c.segments.iter().find(|g| g.steps[0] == s.step)?;
+            let seg = segment_starting_at(&c.segments, s.step)?;
             let first = c.points.get(s.step - 1)?;
             let y = first.resultant[k] + seg.slope[k] * (seg.alpha[0] - first.alpha);
             Some((s.estimated_strain[k], y))

@@ -19,7 +19,7 @@ pub use curve_files::{
 };
 pub use error::InputError;
 pub use matrix_market::write_matrix_market;
-pub use native::{parse_json, parse_toml, to_json, to_toml};
+pub use native::{parse_json, parse_toml, parse_toml_as, to_json, to_toml};
 pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};
 pub use results::{
     contacts_csv, displacements_csv, incremental_json, increments_csv, solution_json,
@@ -50,9 +50,40 @@ pub fn read_description(path: &Path) -> Result<ModelDescription, Error> {
         Some("inp") => parse_abaqus,
         _ => return Err(InputError::UnknownFormat { path: shown }.into()),
     };
-    let text = std::fs::read_to_string(path).map_err(|e| InputError::Read {
-        path: shown.clone(),
+    Ok(parse(&read_text(path)?, &shown)?)
+}
+
+fn read_text(path: &Path) -> Result<String, InputError> {
+    std::fs::read_to_string(path).map_err(|e| InputError::Read {
+        path: path.display().to_string(),
         message: e.to_string(),
+    })
+}
+
+/// Reads a TOML file into `T` (e.g. generator parameters such as
+/// [`NonWoven`](crate::generate::NonWoven)); errors name the file, line and column.
+pub fn read_toml_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, Error> {
+    Ok(parse_toml_as(
+        &read_text(path)?,
+        &path.display().to_string(),
+    )?)
+}
+
+/// Writes a model description as `.toml` or `.json` (by extension), atomically.
+pub fn write_description(path: &Path, d: &ModelDescription) -> Result<(), Error> {
+    let text = match path.extension().and_then(|e| e.to_str()) {
+        Some("json") => to_json(d),
+        Some("toml") => to_toml(d),
+        _ => {
+            return Err(Error::InvalidOption(format!(
+                "{}: the output must be a .toml or .json file",
+                path.display()
+            )))
+        }
+    }
+    .map_err(|message| Error::Output {
+        path: path.display().to_string(),
+        message,
     })?;
-    Ok(parse(&text, &shown)?)
+    write_atomic(path, text.as_bytes())
 }

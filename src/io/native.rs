@@ -12,6 +12,15 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
 
 /// Parses a TOML model; errors carry line and column.
 pub fn parse_toml(text: &str, path: &str) -> Result<ModelDescription, InputError> {
+    parse_toml_as(text, path)
+}
+
+/// Parses any TOML document into `T` (a model, generator parameters); errors carry line and
+/// column.
+pub fn parse_toml_as<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &str,
+) -> Result<T, InputError> {
     toml::from_str(text).map_err(|e| {
         let (line, column) = e.span().map_or((0, 0), |s| line_col(text, s.start));
         InputError::Syntax {
