@@ -559,13 +559,7 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             output,
         } => {
             let mut p = match params {
-                Some(path) => {
-                    let text = std::fs::read_to_string(&path)
-                        .map_err(|e| Error::InvalidOption(format!("{}: {e}", path.display())))?;
-                    toml::from_str::<NonWoven>(&text).map_err(|e| {
-                        Error::InvalidOption(format!("{}: {}", path.display(), e.message()))
-                    })?
-                }
+                Some(path) => io::read_toml_file::<NonWoven>(&path)?,
                 None => match preset {
                     Some(name) => fibercell::generate::nonwoven_preset(&name, 1)?,
                     None => NonWoven::default(),

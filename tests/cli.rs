@@ -328,6 +328,28 @@ fn generate_nonwoven_writes_a_cell_that_stats_reads() {
     let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(doc["fibers"], 80);
     assert!(doc["contacts"].as_u64().unwrap() > 80);
+    // The same kind of cell from a parameter file (the fields of generate::NonWoven).
+    let params = out.join("params.toml");
+    std::fs::write(
+        &params,
+        "size = [4e-3, 4e-3]\namount = { kind = \"count\", fibers = 60 }\n\
+         length = { kind = \"log_normal\", mean = 1.2e-3, cv = 0.2 }\nradius = 1e-5\n\
+         orientation = { kind = \"isotropic\" }\ntilt = 0.0\ncurl = 0.0\n\
+         element_length = 2e-4\ntolerance = 1e-3\nyoung = 1e9\npoisson = 0.3\nmu = 0.2\nseed = 4\n",
+    )
+    .unwrap();
+    let from_file = out.join("from_file.json");
+    let o = run(&[
+        "generate",
+        "nonwoven",
+        "--params",
+        params.to_str().unwrap(),
+        "-o",
+        from_file.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("60 fibers deposited"));
+    assert!(from_file.exists());
     for (args, needle) in [
         (
             vec!["generate", "nonwoven", "--radius=-1", "-o", "x.toml"],
@@ -347,6 +369,28 @@ fn generate_nonwoven_writes_a_cell_that_stats_reads() {
         (
             vec!["generate", "nonwoven", "--preset", "XL", "-o", "x.toml"],
             "unknown cell size",
+        ),
+        (
+            vec![
+                "generate",
+                "nonwoven",
+                "--params",
+                "fixtures/bad_nonwoven_params.toml",
+                "-o",
+                "x.toml",
+            ],
+            "bad_nonwoven_params.toml:3:1: unknown field `fibres`",
+        ),
+        (
+            vec![
+                "generate",
+                "nonwoven",
+                "--params",
+                "fixtures/missing.toml",
+                "-o",
+                "x.toml",
+            ],
+            "cannot read fixtures/missing.toml",
         ),
         (
             vec!["generate", "nonwoven", "--fibers", "10", "-o", "x.vtu"],
