@@ -680,19 +680,25 @@ fn refine(stations: &[Station], h: f64) -> Vec<Station> {
 }
 
 /// Surface gap between the element `ends` (radius r) and a deposited segment shifted by
-/// `shift`, the parameter of the closest point along the element, and the vertical component
-/// of the unit normal from the segment to the element.
-fn gap_at(ends: [[f64; 3]; 2], r: f64, t: &Deposited, shift: [f64; 2]) -> (f64, f64, f64) {
+/// `shift`, the parameter u of the closest point along the element, and the vertical lift of
+/// that point that makes the gap −`tol`/2 with the closest points held: with the horizontal
+/// and vertical parts h, v of their distance, √((r + r′ − tol/2)² − h²) − v (exact for
+/// side-by-side fibers, where the normal is nearly horizontal).
+fn gap_at(
+    ends: [[f64; 3]; 2],
+    r: f64,
+    t: &Deposited,
+    shift: [f64; 2],
+    tol: f64,
+) -> (f64, f64, f64) {
     let [a, b] = t.shifted(shift);
     let cp = closest_points(&ends[0], &ends[1], &a, &b);
-    let zp = ends[0][2] + cp.s * (ends[1][2] - ends[0][2]);
-    let zq = a[2] + cp.t * (b[2] - a[2]);
-    let nz = if cp.distance > 0.0 {
-        (zp - zq) / cp.distance
-    } else {
-        1.0
-    };
-    (cp.distance - (r + t.radius), cp.s, nz)
+    let at = |p: [f64; 3], q: [f64; 3], s: f64| [0, 1, 2].map(|k| p[k] + s * (q[k] - p[k]));
+    let (p, q) = (at(ends[0], ends[1], cp.s), at(a, b, cp.t));
+    let h = (p[0] - q[0]).hypot(p[1] - q[1]);
+    let target = r + t.radius - 0.5 * tol;
+    let lift = (target * target - h * h).max(0.0).sqrt() - (p[2] - q[2]);
+    (cp.distance - (r + t.radius), cp.s, lift.max(0.0))
 }
 
 /// The outcome of [`lift`].
@@ -724,25 +730,23 @@ fn lift(
             ];
             grid.near(ends, 2.0 * r, near);
             // The deepest penetration and where along the element it is.
-            let mut worst = (0.0f64, 0.5, 1.0);
+            let mut worst = (0.0f64, 0.5, 0.0);
             for &(id, shift) in near.iter() {
                 let t = grid.segments[id];
-                let (g, u, nz) = gap_at(ends, r, &t, shift);
+                let (g, u, lift) = gap_at(ends, r, &t, shift, tol);
                 if g < -tol && -g > worst.0 {
-                    worst = (-g, u, nz);
+                    worst = (-g, u, lift);
                 }
                 if g <= 0.0 {
                     touching.push(t.fiber);
                 }
             }
             if worst.0 > 0.0 {
-                // Lift the element's point at u by the depth less tol/2 (aiming at gap −tol/2),
-                // the two nodes in proportion to their shape functions, so a contact at a
-                // node lifts only that node and the neighbouring supports stay in touch.
-                // A lift dz opens the gap by about dz n_z: side-by-side fibers (small n_z)
-                // need more.
-                let (depth, u, nz) = worst;
-                let dz = (depth - 0.5 * tol) / nz.abs().max(0.05);
+                // Lift the element's point at u by the lift that aims at gap −tol/2, the two
+                // nodes in proportion to their shape functions, so a contact at a node lifts
+                // only that node and the neighbouring supports stay in touch. (A lift of the
+                // penetration depth alone is far too little for side-by-side fibers.)
+                let (_, u, dz) = worst;
                 let w = (1.0 - u) * (1.0 - u) + u * u;
                 stations[k].z += dz * (1.0 - u) / w;
                 stations[k + 1].z += dz * u / w;
