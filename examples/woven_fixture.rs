@@ -4,13 +4,13 @@
 //!
 //! `cargo run --release --example woven_fixture`
 
-use fibercell::generate::{plain_weave, PlainWeave};
+use fibercell::generate::{weave, Weave};
 use fibercell::homogenize::homogenize_elastic;
 use fibercell::solve::SolveOptions;
 use fibercell::Model;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let d = plain_weave(&PlainWeave::default());
+    let d = weave(&Weave::default())?;
     let text = fibercell::io::to_toml(&d)?;
     let header = "# A plain-weave cell like thesis §5.3.4, written by `cargo run --release --example woven_fixture`.\n\
                   # Try: cargo run --release -- homogenize fixtures/woven_plain.toml\n";
@@ -29,10 +29,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("|---|---|---|---|---|");
     for k in 0..=7 {
         let p = 10f64.powi(k);
-        let d = plain_weave(&PlainWeave {
+        let d = weave(&Weave {
             penalty_normal: Some(p),
-            ..PlainWeave::default()
-        });
+            ..Weave::default()
+        })?;
         let h = homogenize_elastic(&Model::from_description(&d)?, &SolveOptions::default())?;
         let t = h.thickness;
         let m = &h.moduli;

@@ -14,12 +14,12 @@
 //! * B = 0 (all fibers in the mid-surface).
 
 mod common;
+use common::grid_abd::{assert_abd, grid_abd};
 use common::GridCell;
 use fibercell::homogenize::{homogenize_elastic, Homogenized};
 use fibercell::model::ModelDescription;
 use fibercell::solve::SolveOptions;
 use fibercell::{Error, Model};
-use std::f64::consts::PI;
 
 const E: f64 = 1.0e9;
 const NU: f64 = 0.3;
@@ -55,31 +55,7 @@ fn homogenize(d: &ModelDescription) -> Homogenized {
 }
 
 fn closed_form(lx: f64, ly: f64) -> [[f64; 6]; 6] {
-    let (a, i, j) = (PI * R * R, PI * R.powi(4) / 4.0, PI * R.powi(4) / 2.0);
-    let g = E / (2.0 * (1.0 + NU));
-    let mut abd = [[0.0; 6]; 6];
-    abd[0][0] = E * a / ly;
-    abd[1][1] = E * a / lx;
-    abd[2][2] = 12.0 * E * i / ((lx + ly) * lx * ly);
-    abd[3][3] = E * i / ly;
-    abd[4][4] = E * i / lx;
-    abd[5][5] = g * j * (lx + ly) / (4.0 * lx * ly);
-    abd
-}
-
-fn assert_abd(got: &[[f64; 6]; 6], want: &[[f64; 6]; 6], tol: f64) {
-    // Each block against its own scale (A ~ EA/L, D ~ EI/L: orders of magnitude apart).
-    for r in 0..6 {
-        for c in 0..6 {
-            let scale = (want[r][r].abs() * want[c][c].abs()).sqrt();
-            assert!(
-                (got[r][c] - want[r][c]).abs() <= tol * scale,
-                "ABD[{r}][{c}] = {:e}, want {:e}",
-                got[r][c],
-                want[r][c]
-            );
-        }
-    }
+    grid_abd(E, NU, R, lx, ly)
 }
 
 #[test]

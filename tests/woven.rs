@@ -5,17 +5,18 @@
 //! The square weave is invariant under the 90° rotation that swaps warps and wefts, so
 //! A11 = A22 and D11 = D22.
 
-use fibercell::generate::{plain_weave, PlainWeave};
+use fibercell::generate::{weave, Weave, WeavePattern};
 use fibercell::homogenize::{homogenize_elastic, Homogenized};
 use fibercell::solve::SolveOptions;
 use fibercell::{io, Model};
 use std::path::Path;
 
 fn moduli(p: f64) -> Homogenized {
-    let d = plain_weave(&PlainWeave {
+    let d = weave(&Weave {
         penalty_normal: Some(p),
-        ..PlainWeave::default()
-    });
+        ..Weave::default()
+    })
+    .unwrap();
     homogenize_elastic(
         &Model::from_description(&d).unwrap(),
         &SolveOptions::default(),
@@ -61,5 +62,102 @@ fn the_square_weave_is_symmetric_under_the_quarter_turn() {
 #[test]
 fn the_committed_fixture_is_the_generated_cell() {
     let committed = io::read_description(Path::new("fixtures/woven_plain.toml")).unwrap();
-    assert_eq!(committed, plain_weave(&PlainWeave::default()));
+    assert_eq!(committed, weave(&Weave::default()).unwrap());
+}
+
+fn twill(over: usize, under: usize) -> fibercell::model::ModelDescription {
+    let r = (over + under) as f64;
+    weave(&Weave {
+        pattern: WeavePattern::Twill { over, under },
+        size: [2e-3 * r, 2e-3 * r],
+        ..Weave::default()
+    })
+    .unwrap()
+}
+
+#[test]
+fn twill_crossovers_are_all_closed_and_follow_the_pattern() {
+    for (over, under) in [(2, 1), (2, 2), (3, 1)] {
+        let d = twill(over, under);
+        let r = over + under;
+        assert_eq!(d.fibers.len(), 2 * r);
+        let m = Model::from_description(&d).unwrap();
+        let s = fibercell::stats::network_stats(&m).unwrap();
+        assert_eq!(
+            s.contacts,
+            r * r,
+            "{over}/{under} twill: every crossover closed"
+        );
+        // Warp j floats over `over` consecutive wefts: at weft i (x = (i + ½) L/R) it is up.
+        for j in 0..r {
+            let warp = &d.fibers[j];
+            let ups = (0..r)
+                .filter(|&i| {
+                    let x = (i as f64 + 0.5) * 2e-3;
+                    warp.nodes.iter().any(|&id| {
+                        let p = d.nodes[id as usize - 1].x;
+                        (p[0] - x).abs() < 1e-12 && p[2] > 0.0
+                    })
+                })
+                .count();
+            assert_eq!(ups, over, "warp {j} of the {over}/{under} twill");
+        }
+    }
+}
+
+#[test]
+fn a_balanced_twill_homogenizes_with_equal_warp_and_weft_stiffness() {
+    // A 2/2 twill maps onto itself when warps and wefts swap (and the cell shifts by one
+    // yarn), so A11 = A22 and D11 = D22.
+    let h = homogenize_elastic(
+        &Model::from_description(&twill(2, 2)).unwrap(),
+        &SolveOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(h.contacts, 16);
+    let a = h.abd;
+    assert!(h.asymmetry < 1e-10);
+    assert!(
+        (a[0][0] - a[1][1]).abs() <= 1e-8 * a[0][0],
+        "{} {}",
+        a[0][0],
+        a[1][1]
+    );
+    assert!(
+        (a[3][3] - a[4][4]).abs() <= 1e-8 * a[3][3],
+        "{} {}",
+        a[3][3],
+        a[4][4]
+    );
+    assert!((0..6).all(|k| a[k][k] > 0.0));
+}
+
+#[test]
+fn bad_weave_parameters_name_the_field() {
+    for (bad, field) in [
+        (
+            Weave {
+                radius: 1e-3,
+                ..Weave::default()
+            },
+            "diameter",
+        ),
+        (
+            Weave {
+                pattern: WeavePattern::Twill { over: 0, under: 2 },
+                ..Weave::default()
+            },
+            "over 0",
+        ),
+        (
+            Weave {
+                young: f64::NAN,
+                ..Weave::default()
+            },
+            "young",
+        ),
+    ] {
+        let err = weave(&bad).unwrap_err().to_string();
+        assert!(err.contains(field), "{err}");
+    }
 }

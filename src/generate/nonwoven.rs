@@ -20,6 +20,7 @@
 //!
 //! Fibers that end up touching nothing would float; they are dropped and counted.
 
+use super::check::{invalid, material, positive};
 use super::orientation::{sample_angle, Orientation};
 use super::segment_grid::{Deposited, SegmentGrid};
 use crate::contact::closest_points;
@@ -174,37 +175,17 @@ pub struct GeneratedCell {
     pub report: DepositionReport,
 }
 
-fn invalid(msg: String) -> Error {
-    Error::InvalidOption(msg)
-}
-
 impl NonWoven {
     /// Checks every parameter, naming the bad one.
     pub fn validate(&self) -> Result<(), Error> {
-        let positive = |name: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(invalid(format!(
-                    "non-woven {name} = {v} must be positive and finite"
-                )))
-            }
-        };
+        let positive = |name: &str, v: f64| positive("non-woven", name, v);
         positive("size[0]", self.size[0])?;
         positive("size[1]", self.size[1])?;
         positive("radius", self.radius)?;
         positive("element_length", self.element_length)?;
         positive("young", self.young)?;
         positive("tolerance", self.tolerance)?;
-        if !(self.poisson > -1.0 && self.poisson < 0.5) {
-            return Err(invalid(format!(
-                "non-woven poisson = {} must be in (−1, 0.5)",
-                self.poisson
-            )));
-        }
-        if !(self.mu >= 0.0 && self.mu.is_finite()) {
-            return Err(invalid(format!("non-woven mu = {} must be ≥ 0", self.mu)));
-        }
+        material("non-woven", self.poisson, self.mu)?;
         if !(self.tilt >= 0.0 && self.tilt < 1.5) {
             return Err(invalid(format!(
                 "non-woven tilt = {} rad must be in [0, 1.5)",

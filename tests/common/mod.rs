@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests: small model builders.
 #![allow(dead_code)]
 
+pub mod grid_abd;
 pub mod zigzag;
 
 use fibercell::model::{
