@@ -1,7 +1,7 @@
 //! Statistics of a fiber network: fiber count, total length, solid volume fraction,
 //! orientation tensor, contacts and the mean free segment length between contacts.
 
-use crate::cell::pair_boundary_nodes;
+use crate::cell::{pair_boundary_nodes, Periodicity};
 use crate::contact::ContactSet;
 use crate::model::Model;
 use crate::Error;
@@ -101,23 +101,7 @@ pub fn network_stats(model: &Model) -> Result<NetworkStats, Error> {
     let thickness = periodic.as_ref().map_or(z_extent, |p| p.geometry.thickness);
     let set = ContactSet::build_with(model, periodic.as_ref())?;
     let contacts = set.pairs.iter().filter(|p| p.gap <= 0.0).count();
-    // Physical fibers: a slave node that ends one piece and whose master ends another joins
-    // the two.
-    let mut ends: Vec<u32> = vec![0; model.nodes.len()];
-    for f in &model.fibers {
-        if let (Some(&a), Some(&b)) = (f.nodes.first(), f.nodes.last()) {
-            ends[a] += 1;
-            ends[b] += 1;
-        }
-    }
-    let joins = periodic.as_ref().map_or(0, |p| {
-        p.master
-            .iter()
-            .enumerate()
-            .filter(|(n, m)| matches!(m, Some((master, _)) if ends[*n] == 1 && ends[*master] == 1))
-            .count()
-    });
-    let fibers = model.fibers.len().saturating_sub(joins);
+    let fibers = physical_fibers(model, periodic.as_ref());
     Ok(NetworkStats {
         fiber_pieces: model.fibers.len(),
         fibers,
@@ -166,6 +150,47 @@ pub fn orientation_histogram(model: &Model, bins: usize) -> Vec<f64> {
         h.iter_mut().for_each(|v| *v /= total);
     }
     h
+}
+
+/// Physical fibers: pieces joined end to end through paired boundary nodes (a slave node that
+/// ends one piece and whose master ends another) count once — as a chain, or as a ring for a
+/// yarn that runs around the cell.
+fn physical_fibers(model: &Model, periodic: Option<&Periodicity>) -> usize {
+    let n = model.nodes.len();
+    // The piece each node ends (None: no end, or the end of several pieces — a junction).
+    let mut end_of: Vec<Option<usize>> = vec![None; n];
+    let mut ends = vec![0u32; n];
+    for (k, f) in model.fibers.iter().enumerate() {
+        if let (Some(&a), Some(&b)) = (f.nodes.first(), f.nodes.last()) {
+            for e in [a, b] {
+                ends[e] += 1;
+                end_of[e] = Some(k);
+            }
+        }
+    }
+    let mut parent: Vec<usize> = (0..model.fibers.len()).collect();
+    fn root(parent: &mut [usize], mut k: usize) -> usize {
+        while parent[k] != k {
+            parent[k] = parent[parent[k]];
+            k = parent[k];
+        }
+        k
+    }
+    if let Some(p) = periodic {
+        for (slave, m) in p.master.iter().enumerate() {
+            if let Some((master, _)) = *m {
+                if let (1, 1, Some(a), Some(b)) =
+                    (ends[slave], ends[master], end_of[slave], end_of[master])
+                {
+                    let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                    parent[ra] = rb;
+                }
+            }
+        }
+    }
+    (0..parent.len())
+        .filter(|&k| root(&mut parent, k) == k)
+        .count()
 }
 
 impl NetworkStats {

@@ -81,6 +81,13 @@ fn twill_crossovers_are_all_closed_and_follow_the_pattern() {
         let d = twill(over, under);
         let r = over + under;
         assert_eq!(d.fibers.len(), 2 * r);
+        assert_eq!(
+            fibercell::stats::network_stats(&Model::from_description(&d).unwrap())
+                .unwrap()
+                .fibers,
+            2 * r,
+            "each yarn runs around the cell: one ring"
+        );
         let m = Model::from_description(&d).unwrap();
         let s = fibercell::stats::network_stats(&m).unwrap();
         assert_eq!(

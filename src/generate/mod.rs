@@ -3,13 +3,16 @@
 mod check;
 mod geotextile;
 mod grid;
+mod knitted;
 mod nonwoven;
 mod orientation;
 mod segment_grid;
 mod woven;
+mod wrap;
 
 pub use geotextile::{geotextile, FiberFamily, Geotextile, LayerJunction};
 pub use grid::{clamped_grid, crossing_grid};
+pub use knitted::{knitted, Knit};
 pub use nonwoven::{
     nonwoven, nonwoven_preset, DepositionReport, FiberAmount, GeneratedCell, LengthDistribution,
     NonWoven,

@@ -23,10 +23,9 @@
 use super::check::{invalid, material, positive};
 use super::orientation::{sample_angle, Orientation};
 use super::segment_grid::{Deposited, SegmentGrid};
+use super::wrap::push_fiber;
 use crate::contact::closest_points;
-use crate::model::{
-    CellSpec, ContactSpec, FiberSpec, FrictionSpec, MaterialSpec, ModelDescription, NodeSpec,
-};
+use crate::model::{CellSpec, ContactSpec, FrictionSpec, MaterialSpec, ModelDescription};
 use crate::Error;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -819,20 +818,7 @@ fn describe(
         if !touched[*fiber] {
             continue;
         }
-        let ids: Vec<u64> = nodes
-            .iter()
-            .map(|&x| {
-                let id = d.nodes.len() as u64 + 1;
-                d.nodes.push(NodeSpec { id, x });
-                id
-            })
-            .collect();
-        d.fibers.push(FiberSpec {
-            id: d.fibers.len() as u64 + 1,
-            nodes: ids,
-            radius: r,
-            material: "fiber".into(),
-        });
+        push_fiber(&mut d, nodes, r, "fiber");
     }
     report.pieces = d.fibers.len();
     if d.fibers.is_empty() {
