@@ -162,6 +162,109 @@ enum GenerateKind {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// A plain or twill weave (see the README).
+    Woven {
+        /// All parameters from a TOML file (the fields of `generate::Weave`).
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// plain, or twill:OVER/UNDER (e.g. twill:2/1).
+        #[arg(long, value_parser = parse_weave_pattern)]
+        pattern: Option<fibercell::generate::WeavePattern>,
+        /// Cell size Lx,Ly (m): one repeat of the pattern.
+        #[arg(long, value_parser = parse_pair)]
+        size: Option<[f64; 2]>,
+        /// Yarn radius (m).
+        #[arg(long)]
+        radius: Option<f64>,
+        /// Output model (.toml or .json).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// A geotextile: families of straight fibers with fixed junctions, in layers.
+    Geotextile {
+        /// All parameters from a TOML file (the fields of `generate::Geotextile`).
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Cell periods Lx,Ly (m).
+        #[arg(long, value_parser = parse_pair)]
+        size: Option<[f64; 2]>,
+        /// A fiber family ANGLE_DEG,SPACING,RADIUS[,LAYER]; repeat for each family.
+        #[arg(long = "family", value_parser = parse_family)]
+        families: Vec<fibercell::generate::FiberFamily>,
+        /// Layers touch with Coulomb friction MU instead of connector beams.
+        #[arg(long)]
+        contact_mu: Option<f64>,
+        /// Largest element length (m).
+        #[arg(long)]
+        element_length: Option<f64>,
+        /// Output model (.toml or .json).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// A plain-jersey knit of interlocked loops.
+    Knitted {
+        /// All parameters from a TOML file (the fields of `generate::Knit`).
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Loops per course in the cell.
+        #[arg(long)]
+        wales: Option<usize>,
+        /// Courses in the cell.
+        #[arg(long)]
+        courses: Option<usize>,
+        /// Yarn radius (m).
+        #[arg(long)]
+        radius: Option<f64>,
+        /// Output model (.toml or .json).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+}
+
+fn parse_weave_pattern(s: &str) -> Result<fibercell::generate::WeavePattern, String> {
+    use fibercell::generate::WeavePattern;
+    if s == "plain" {
+        return Ok(WeavePattern::Plain);
+    }
+    let floats = s
+        .strip_prefix("twill:")
+        .and_then(|f| f.split_once('/'))
+        .ok_or_else(|| format!("\"{s}\" is not plain or twill:OVER/UNDER"))?;
+    let num = |v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("\"{v}\" is not a whole number"))
+    };
+    Ok(WeavePattern::Twill {
+        over: num(floats.0)?,
+        under: num(floats.1)?,
+    })
+}
+
+fn parse_family(s: &str) -> Result<fibercell::generate::FiberFamily, String> {
+    let v: Vec<&str> = s.split(',').collect();
+    if !(3..=4).contains(&v.len()) {
+        return Err(format!("\"{s}\" is not ANGLE_DEG,SPACING,RADIUS[,LAYER]"));
+    }
+    let num = |x: &str| {
+        x.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("\"{x}\" is not a number"))
+    };
+    let layer = match v.get(3) {
+        Some(l) => l
+            .trim()
+            .parse::<usize>()
+            .map_err(|_| format!("layer \"{l}\" is not a whole number"))?,
+        None => 0,
+    };
+    Ok(fibercell::generate::FiberFamily {
+        angle_degrees: num(v[0])?,
+        spacing: num(v[1])?,
+        radius: num(v[2])?,
+        offset: None,
+        layer,
+    })
 }
 
 fn parse_pair(s: &str) -> Result<[f64; 2], String> {
@@ -607,24 +710,113 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             }
             let t = std::time::Instant::now();
             let cell = fibercell::generate::nonwoven(&p)?;
-            let elapsed = t.elapsed().as_secs_f64();
-            io::write_description(&output, &cell.description)?;
-            let model = fibercell::Model::from_description(&cell.description)?;
-            let stats = fibercell::stats::network_stats(&model)?;
             let r = &cell.report;
-            println!(
-                "non-woven (seed {}): {} fibers deposited in {:.2} s, {} dropped (touching nothing), {} supports; written to {}",
-                p.seed,
-                r.deposited,
-                elapsed,
-                r.dropped,
-                r.supports,
-                output.display()
+            let label = format!(
+                "non-woven (seed {}): {} fibers deposited, {} dropped (touching nothing), {} supports",
+                p.seed, r.deposited, r.dropped, r.supports
             );
-            println!("{}", stats.summary());
-            Ok(())
+            finish_generated(&label, t, &cell.description, &output)
+        }
+        GenerateKind::Woven {
+            params,
+            pattern,
+            size,
+            radius,
+            output,
+        } => {
+            let mut p = match params {
+                Some(path) => io::read_toml_file::<fibercell::generate::Weave>(&path)?,
+                None => fibercell::generate::Weave::default(),
+            };
+            if let Some(v) = pattern {
+                p.pattern = v;
+            }
+            if let Some(v) = size {
+                p.size = v;
+            }
+            if let Some(v) = radius {
+                p.radius = v;
+            }
+            let t = std::time::Instant::now();
+            let d = fibercell::generate::weave(&p)?;
+            let label = d.name.clone().unwrap_or_default();
+            finish_generated(&label, t, &d, &output)
+        }
+        GenerateKind::Geotextile {
+            params,
+            size,
+            families,
+            contact_mu,
+            element_length,
+            output,
+        } => {
+            use fibercell::generate::{Geotextile, LayerJunction};
+            let mut p = match params {
+                Some(path) => io::read_toml_file::<Geotextile>(&path)?,
+                None => Geotextile::default(),
+            };
+            if let Some(v) = size {
+                p.size = v;
+            }
+            if !families.is_empty() {
+                p.families = families;
+            }
+            if let Some(mu) = contact_mu {
+                p.layer_junction = LayerJunction::Contact { mu };
+            }
+            if let Some(v) = element_length {
+                p.element_length = v;
+            }
+            let t = std::time::Instant::now();
+            let d = fibercell::generate::geotextile(&p)?;
+            let label = format!("geotextile ({} families)", p.families.len());
+            finish_generated(&label, t, &d, &output)
+        }
+        GenerateKind::Knitted {
+            params,
+            wales,
+            courses,
+            radius,
+            output,
+        } => {
+            let mut p = match params {
+                Some(path) => io::read_toml_file::<fibercell::generate::Knit>(&path)?,
+                None => fibercell::generate::Knit::default(),
+            };
+            if let Some(v) = wales {
+                p.wales = v;
+            }
+            if let Some(v) = courses {
+                p.courses = v;
+            }
+            if let Some(v) = radius {
+                p.radius = v;
+            }
+            let t = std::time::Instant::now();
+            let d = fibercell::generate::knitted(&p)?;
+            let label = d.name.clone().unwrap_or_default();
+            finish_generated(&label, t, &d, &output)
         }
     }
+}
+
+/// Writes a generated cell and prints its statistics.
+fn finish_generated(
+    label: &str,
+    started: std::time::Instant,
+    d: &fibercell::model::ModelDescription,
+    output: &Path,
+) -> Result<(), Error> {
+    let elapsed = started.elapsed().as_secs_f64();
+    let model = fibercell::Model::from_description(d)?;
+    let stats = fibercell::stats::network_stats(&model)?;
+    io::write_description(output, d)?;
+    println!(
+        "{label}: generated in {elapsed:.2} s, written to {}",
+        output.display()
+    );
+    println!("{}", stats.summary());
+    Ok(())
 }
 
 fn stats(model_path: &Path, json: bool, rose: Option<&Path>) -> Result<(), Error> {
