@@ -101,6 +101,14 @@ enum Command {
         #[arg(long, value_name = "PREFIX")]
         rose: Option<PathBuf>,
     },
+    /// Convert a model between formats: .toml, .json, .inp (Abaqus) in and out; .vtu and .pvd
+    /// (ParaView) out.
+    Convert {
+        /// Input model (.toml, .json or .inp).
+        input: PathBuf,
+        /// Output file (.toml, .json, .inp, .vtu or .pvd).
+        output: PathBuf,
+    },
     /// Write the reduced stiffness matrix in Matrix Market form (symmetric, lower triangle).
     ExportMatrix {
         /// Model file.
@@ -844,6 +852,14 @@ fn stats(model_path: &Path, json: bool, rose: Option<&Path>) -> Result<(), Error
     Ok(())
 }
 
+fn convert(input: &Path, output: &Path) -> Result<(), Error> {
+    let d = io::read_description(input)?;
+    let written = io::write_model(output, &d)?;
+    let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+    println!("{} → {}", input.display(), names.join(", "));
+    Ok(())
+}
+
 fn export_matrix(model_path: &Path, out: &Path) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
     let sys = fibercell::solve::ReducedSystem::assemble(&model, Default::default())?;
@@ -904,6 +920,7 @@ fn main() -> ExitCode {
         } => curve(&model, (strain, steps, unload), solver, json, &output),
         Command::Generate { kind } => generate(kind),
         Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),
+        Command::Convert { input, output } => convert(&input, &output),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
     };
     match r {

@@ -37,6 +37,14 @@ struct Reader {
     supports: Vec<SupportSpec>,
     loads: Vec<LoadSpec>,
     steps: usize,
+    /// `*EQUATION`s: (line, terms (node or set, DOF, coefficient)).
+    equations: Vec<super::abaqus_cell::Equation>,
+    /// The equation being read: its number of terms and line.
+    equation: Option<(usize, usize)>,
+    /// `** fibercell-…:` settings.
+    contact: Option<crate::model::ContactSpec>,
+    contacts: Vec<crate::model::ContactPairSpec>,
+    cell: Option<crate::model::CellSpec>,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -53,6 +61,7 @@ enum Block {
     Static,
     Boundary,
     Cload,
+    Equation,
 }
 
 fn params(parts: &[&str]) -> HashMap<String, String> {
@@ -144,6 +153,9 @@ impl Reader {
             };
             if inc == 0 || b < a {
                 return Err(self.err(line, "GENERATE needs first ≤ last and a positive increment"));
+            }
+            if (b - a) / inc >= 100_000_000 {
+                return Err(self.err(line, "GENERATE range of more than 10⁸ members"));
             }
             return Ok((a..=b).step_by(inc as usize).collect());
         }
@@ -302,6 +314,7 @@ impl Reader {
                     });
                 }
             }
+            Block::Equation => self.equation_line(line, fields)?,
             Block::Cload => {
                 need(3, "*CLOAD")?;
                 let targets = self.node_targets(line, fields[0])?;
@@ -325,7 +338,78 @@ impl Reader {
         Ok(block)
     }
 
+    /// A data line of `*EQUATION`: the number of terms, then (node or set, DOF, coefficient)
+    /// triples, several per line.
+    fn equation_line(&mut self, line: usize, fields: &[&str]) -> Result<(), InputError> {
+        let fields: Vec<&str> = fields
+            .iter()
+            .map(|f| f.trim())
+            .filter(|f| !f.is_empty())
+            .collect();
+        match self.equation {
+            None => {
+                if fields.len() != 1 {
+                    return Err(self.err(line, "*EQUATION: expected the number of terms"));
+                }
+                let n = self.id(line, fields[0], "number of terms")? as usize;
+                if !(2..=1000).contains(&n) {
+                    return Err(self.err(line, format!("*EQUATION with {n} terms (2 to 1000)")));
+                }
+                self.equation = Some((n, line));
+                self.equations.push((line, Vec::with_capacity(n)));
+            }
+            Some((n, _)) => {
+                if !fields.len().is_multiple_of(3) {
+                    return Err(self.err(line, "*EQUATION terms come as node, DOF, coefficient"));
+                }
+                for t in fields.chunks(3) {
+                    let dof = self.dof(line, t[1])?.dofs()[0].index() + 1;
+                    let c = self.num(line, t[2], "coefficient")?;
+                    if let Some((_, terms)) = self.equations.last_mut() {
+                        terms.push((t[0].to_ascii_uppercase(), dof, c));
+                    }
+                }
+                let have = self.equations.last().map_or(0, |e| e.1.len());
+                if have > n {
+                    return Err(
+                        self.err(line, format!("*EQUATION has {have} terms, {n} announced"))
+                    );
+                }
+                if have == n {
+                    self.equation = None;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn json_setting<T: serde::de::DeserializeOwned>(
+        &self,
+        line: usize,
+        body: &str,
+    ) -> Result<T, InputError> {
+        serde_json::from_str(body.trim())
+            .map_err(|e| self.err(line, format!("fibercell setting: {e}")))
+    }
+
+    /// A `** fibercell-…:` comment: settings with no Abaqus keyword, as JSON.
+    fn fibercell_comment(&mut self, line: usize, t: &str) -> Result<(), InputError> {
+        use super::abaqus_export::{CELL_COMMENT, CONTACT_COMMENT, PAIR_COMMENT};
+        if let Some(body) = t.strip_prefix(CONTACT_COMMENT) {
+            self.contact = Some(self.json_setting(line, body)?);
+        } else if let Some(body) = t.strip_prefix(PAIR_COMMENT) {
+            let pair = self.json_setting(line, body)?;
+            self.contacts.push(pair);
+        } else if let Some(body) = t.strip_prefix(CELL_COMMENT) {
+            self.cell = Some(self.json_setting(line, body)?);
+        }
+        Ok(())
+    }
+
     fn keyword(&mut self, line: usize, text: &str, ctx: &mut Context) -> Result<Block, InputError> {
+        if let Some((n, start)) = self.equation.take() {
+            return Err(self.err(start, format!("*EQUATION ends before its {n} terms")));
+        }
         let parts: Vec<&str> = text[1..].split(',').collect();
         let kw = parts[0].trim().to_ascii_uppercase();
         let p = params(&parts[1..]);
@@ -399,10 +483,11 @@ impl Reader {
                 Block::BeamSection
             }
             "MATERIAL" => {
+                // Names are case-insensitive; the spelling of the definition is kept.
                 ctx.material = Some(
                     p.get("NAME")
                         .ok_or_else(|| self.err(line, "*MATERIAL needs NAME="))?
-                        .to_ascii_uppercase(),
+                        .to_string(),
                 );
                 Block::None
             }
@@ -431,6 +516,10 @@ impl Reader {
                     return Err(self.err(line, "*BOUNDARY options TYPE= and OP= are not supported"));
                 }
                 Block::Boundary
+            }
+            "EQUATION" => {
+                self.equation = None;
+                Block::Equation
             }
             "CLOAD" => {
                 if p.contains_key("OP") {
@@ -513,6 +602,10 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let t = raw.trim();
+        if t.starts_with("** fibercell-") {
+            r.fibercell_comment(line, t)?;
+            continue;
+        }
         if t.is_empty() || t.starts_with("**") {
             continue;
         }
@@ -533,7 +626,11 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
     let by_id: HashMap<u64, (u64, u64, u64)> = r.elements.iter().map(|e| (e.0, *e)).collect();
     let mut owner: HashMap<u64, usize> = HashMap::new();
     let mut fibers = Vec::new();
-    let materials: HashMap<String, ()> = r.materials.iter().map(|m| (m.name.clone(), ())).collect();
+    let materials: HashMap<String, String> = r
+        .materials
+        .iter()
+        .map(|m| (m.name.to_ascii_uppercase(), m.name.clone()))
+        .collect();
     for (si, s) in r.sections.iter().enumerate() {
         let radius = s.radius.ok_or_else(|| {
             path_err(
@@ -541,12 +638,12 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
                 "*BEAM SECTION has no data line with the radius".into(),
             )
         })?;
-        if !materials.contains_key(&s.material) {
+        let Some(material) = materials.get(&s.material) else {
             return Err(path_err(
                 s.line,
                 format!("*BEAM SECTION refers to unknown material {}", s.material),
             ));
-        }
+        };
         let members = r
             .elsets
             .get(&s.elset)
@@ -570,12 +667,19 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
             }
             els.push(*e);
         }
-        for (id, nodes) in chain(&els) {
+        let chains = chain(&els);
+        // A section of its own per fiber (`FIBER-<id>`, as fibercell writes) keeps the fiber id.
+        let own_id = s
+            .elset
+            .strip_prefix("FIBER-")
+            .and_then(|n| n.parse::<u64>().ok())
+            .filter(|_| chains.len() == 1);
+        for (id, nodes) in chains {
             fibers.push(FiberSpec {
-                id,
+                id: own_id.unwrap_or(id),
                 nodes,
                 radius,
-                material: s.material.clone(),
+                material: material.clone(),
             });
         }
     }
@@ -585,14 +689,31 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
             format!("element {id} has no *BEAM SECTION"),
         ));
     }
+    if let Some((n, line)) = r.equation {
+        return Err(path_err(
+            line,
+            format!("*EQUATION ends before its {n} terms"),
+        ));
+    }
+    let periodic = super::abaqus_cell::periodic_cell(&r.nodes, &r.nsets, &r.equations, path)?;
+    let nodes = match &periodic {
+        Some(p) => r
+            .nodes
+            .into_iter()
+            .filter(|n| !p.drivers.contains(&n.id))
+            .collect(),
+        None => r.nodes,
+    };
     Ok(ModelDescription {
         name: r.name,
         materials: r.materials,
-        nodes: r.nodes,
+        nodes,
         fibers,
         supports: r.supports,
         loads: r.loads,
-        ..Default::default()
+        contact: r.contact,
+        contacts: r.contacts,
+        cell: r.cell.or(periodic.map(|p| p.cell)),
     })
 }
 

@@ -2,6 +2,8 @@
 //! (CSV, JSON), VTK `.vtu`, Matrix Market output and plots (SVG, PNG). Outputs are written atomically.
 
 mod abaqus;
+mod abaqus_cell;
+mod abaqus_export;
 mod atomic;
 mod curve_files;
 mod error;
@@ -12,6 +14,7 @@ mod results;
 mod vtk;
 
 pub use abaqus::parse_abaqus;
+pub use abaqus_export::to_abaqus;
 pub use atomic::write_atomic;
 pub use curve_files::{
     curve_csv, curve_plot, dominant_component, switches_csv, write_curve_files, RESULTANT_NAMES,
@@ -24,7 +27,7 @@ pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};
 pub use results::{
     contacts_csv, displacements_csv, incremental_json, increments_csv, solution_json,
 };
-pub use vtk::{contacts_vtu, deformed_vtu, series_pvd, step_file};
+pub use vtk::{contacts_vtu, deformed_vtu, model_vtk, series_pvd, step_file};
 
 use crate::model::{Model, ModelDescription};
 use crate::Error;
@@ -86,4 +89,45 @@ pub fn write_description(path: &Path, d: &ModelDescription) -> Result<(), Error>
         message,
     })?;
     write_atomic(path, text.as_bytes())
+}
+
+/// Writes a model in the format of the path's extension — `.toml`, `.json`, `.inp` (Abaqus),
+/// `.vtu` (the network with its radius) or `.pvd` (a collection of `{stem}_fibers.vtu` and
+/// `{stem}_contacts.vtu` written next to it) — validating it first; each file is written
+/// atomically. Returns the paths written.
+pub fn write_model(path: &Path, d: &ModelDescription) -> Result<Vec<std::path::PathBuf>, Error> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    let model = Model::from_description(d)?;
+    match ext.as_deref() {
+        Some("toml") | Some("json") => write_description(path, d)?,
+        Some("inp") => write_atomic(path, to_abaqus(d)?.as_bytes())?,
+        Some("vtu") => write_atomic(
+            path,
+            deformed_vtu(&model, &vec![[0.0; 6]; model.nodes.len()]).as_bytes(),
+        )?,
+        Some("pvd") => {
+            let stem = path
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("model")
+                .to_string();
+            let (network, contacts, pvd) = model_vtk(&model, &stem)?;
+            let fibers = path.with_file_name(format!("{stem}_fibers.vtu"));
+            let points = path.with_file_name(format!("{stem}_contacts.vtu"));
+            write_atomic(&fibers, network.as_bytes())?;
+            write_atomic(&points, contacts.as_bytes())?;
+            write_atomic(path, pvd.as_bytes())?;
+            return Ok(vec![path.to_path_buf(), fibers, points]);
+        }
+        _ => {
+            return Err(Error::InvalidOption(format!(
+                "{}: unknown output format (use .toml, .json, .inp, .vtu or .pvd)",
+                path.display()
+            )))
+        }
+    }
+    Ok(vec![path.to_path_buf()])
 }

@@ -1,8 +1,9 @@
 //! VTK XML unstructured grid (`.vtu`) of the deformed network: one line cell per element,
 //! the radius as point data for ParaView's tube filter, displacements and rotations.
 
+use crate::contact::{ContactOrigin, ContactSet, ContactState};
 use crate::model::Model;
-use crate::solve::IncrementalSolution;
+use crate::solve::{ContactRecord, IncrementalSolution};
 use std::fmt::Write;
 
 /// The deformed network (positions x + u) as an ASCII `.vtu` document.
@@ -76,14 +77,19 @@ pub fn deformed_vtu(model: &Model, displacements: &[[f64; 6]]) -> String {
 /// (0 open, 1 stick, 2 slip), `normal_force`, `tangential_force` (vector) and `gap`.
 pub fn contacts_vtu(sol: &IncrementalSolution, step: usize) -> String {
     let records = sol.contact_results.get(step).map(|r| &r[..]).unwrap_or(&[]);
-    let n = records.len();
+    contact_points_vtu(&sol.contacts.origins, records)
+}
+
+/// Contact points (side I) with their records as vertex cells.
+fn contact_points_vtu(origins: &[ContactOrigin], records: &[ContactRecord]) -> String {
+    let n = records.len().min(origins.len());
     let mut s = String::with_capacity(200 * n + 1000);
     s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n");
     let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">");
     s.push_str(
         "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
     );
-    for o in &sol.contacts.origins {
+    for o in &origins[..n] {
         let _ = writeln!(s, "{:e} {:e} {:e}", o.point[0], o.point[1], o.point[2]);
     }
     s.push_str("</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
@@ -146,4 +152,47 @@ pub fn series_pvd(sol: &IncrementalSolution) -> String {
 /// `{prefix}_{step:04}.vtu`.
 pub fn step_file(prefix: &str, step: usize) -> String {
     format!("{prefix}_{step:04}.vtu")
+}
+
+/// The undeformed model for ParaView: the network (`.vtu` with the radius for the tube filter)
+/// and its contacts as found by the search (closed: state 1, open candidates: state 0, with the
+/// initial gap), and a `.pvd` collection of the two (parts 0 and 1) naming them
+/// `{stem}_fibers.vtu` and `{stem}_contacts.vtu`. Returns (network, contacts, collection).
+pub fn model_vtk(model: &Model, stem: &str) -> Result<(String, String, String), crate::Error> {
+    let network = deformed_vtu(model, &vec![[0.0; 6]; model.nodes.len()]);
+    let periodic = match model.cell {
+        Some(_) => Some(crate::cell::pair_boundary_nodes(model)?),
+        None => None,
+    };
+    let set = match model.contact {
+        Some(_) => ContactSet::build_with(model, periodic.as_ref())?,
+        None => ContactSet::default(),
+    };
+    let records: Vec<ContactRecord> = set
+        .pairs
+        .iter()
+        .map(|p| ContactRecord {
+            state: if p.gap <= 0.0 {
+                ContactState::Stick
+            } else {
+                ContactState::Open
+            },
+            gap: p.gap,
+            normal_force: 0.0,
+            tangential_force: [0.0; 3],
+            tangential_magnitude: 0.0,
+            friction_bound: 0.0,
+            relative_tangential: [0.0; 3],
+        })
+        .collect();
+    let contacts = contact_points_vtu(&set.origins, &records);
+    let mut pvd = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n");
+    for (part, what) in ["fibers", "contacts"].iter().enumerate() {
+        let _ = writeln!(
+            pvd,
+            "<DataSet timestep=\"0\" group=\"\" part=\"{part}\" file=\"{stem}_{what}.vtu\"/>"
+        );
+    }
+    pvd.push_str("</Collection>\n</VTKFile>\n");
+    Ok((network, contacts, pvd))
 }
