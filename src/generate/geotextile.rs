@@ -103,6 +103,12 @@ impl Geotextile {
         ] {
             positive(name, v)?;
         }
+        if lx.hypot(ly) / self.element_length > 1e6 {
+            return Err(invalid(format!(
+                "geotextile: element_length = {} gives more than 10⁶ elements per fiber",
+                self.element_length
+            )));
+        }
         let mu = match self.layer_junction {
             LayerJunction::Contact { mu } => mu,
             LayerJunction::Fixed => 0.0,
@@ -127,6 +133,12 @@ impl Geotextile {
                 )));
             }
             let (s, c) = f.angle_degrees.to_radians().sin_cos();
+            let lines = (lx * s.abs() + ly * c.abs()) / f.spacing;
+            if lines > 10_000.0 {
+                return Err(invalid(format!(
+                    "geotextile: families[{k}] has {lines:.0} fibers per cell (at most 10,000)"
+                )));
+            }
             for (axis, count) in [
                 ("x", lx * s.abs() / f.spacing),
                 ("y", ly * c.abs() / f.spacing),

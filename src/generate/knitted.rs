@@ -90,9 +90,9 @@ impl Knit {
                 self.wales, self.courses
             )));
         }
-        if self.loop_elements < 8 || self.loop_elements > 10_000 {
+        if self.loop_elements < 8 || self.loop_elements > 1_000 {
             return Err(invalid(format!(
-                "knitted: loop_elements = {} must be in [8, 10000]",
+                "knitted: loop_elements = {} must be in [8, 1000]",
                 self.loop_elements
             )));
         }

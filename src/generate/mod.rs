@@ -1,5 +1,6 @@
 //! Model generators.
 
+mod catalog;
 mod check;
 mod geotextile;
 mod grid;
@@ -10,6 +11,7 @@ mod segment_grid;
 mod woven;
 mod wrap;
 
+pub use catalog::{reference_results, CellParams, ReferenceResults};
 pub use geotextile::{geotextile, FiberFamily, Geotextile, LayerJunction};
 pub use grid::{clamped_grid, crossing_grid};
 pub use knitted::{knitted, Knit};

@@ -109,8 +109,11 @@ impl Weave {
             positive("penalty_normal", p)?;
         }
         material("woven", self.poisson, self.mu)?;
-        if self.half_pitch_elements == 0 {
-            return Err(invalid("woven: half_pitch_elements must be ≥ 1".into()));
+        if !(1..=10_000).contains(&self.half_pitch_elements) {
+            return Err(invalid(format!(
+                "woven: half_pitch_elements = {} must be in [1, 10000]",
+                self.half_pitch_elements
+            )));
         }
         let (o, u) = self.pattern.floats();
         if o == 0 || u == 0 || o + u > 64 {

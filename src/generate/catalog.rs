@@ -1,0 +1,72 @@
+//! The fixture catalog: a small and a medium cell of each fabric family, from parameter files
+//! `fixtures/cells/<family>_<size>.params.toml`, and their reference results.
+
+use super::{geotextile, knitted, nonwoven, weave, Geotextile, Knit, NonWoven, Weave};
+use crate::model::ModelDescription;
+use crate::Error;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Parameters of a cell of any family, tagged by `family` in the parameter file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "family", rename_all = "snake_case")]
+pub enum CellParams {
+    /// [`Weave`].
+    Woven(Weave),
+    /// [`Geotextile`].
+    Geotextile(Geotextile),
+    /// [`Knit`].
+    Knitted(Knit),
+    /// [`NonWoven`].
+    Nonwoven(NonWoven),
+}
+
+impl CellParams {
+    /// Reads a parameter file (TOML); errors name the file, line and column.
+    pub fn read(path: &Path) -> Result<Self, Error> {
+        crate::io::read_toml_file(path)
+    }
+
+    /// The cell.
+    pub fn generate(&self) -> Result<ModelDescription, Error> {
+        match self {
+            CellParams::Woven(p) => weave(p),
+            CellParams::Geotextile(p) => geotextile(p),
+            CellParams::Knitted(p) => knitted(p),
+            CellParams::Nonwoven(p) => Ok(nonwoven(p)?.description),
+        }
+    }
+}
+
+/// What the fixtures' reference files record of a cell: its statistics and elastic ABD.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceResults {
+    /// Physical fibers.
+    pub fibers: usize,
+    /// Elements.
+    pub elements: usize,
+    /// Total centerline length (m).
+    pub total_length: f64,
+    /// Solid volume fraction (with the cell's thickness).
+    pub volume_fraction: f64,
+    /// Closed contacts.
+    pub contacts: usize,
+    /// Elastic ABD per unit area (ε11, ε22, γ12, κ11, κ22, κ12).
+    pub abd: [[f64; 6]; 6],
+}
+
+/// The reference results of a cell: statistics and the elastic homogenization with the
+/// default solver.
+pub fn reference_results(d: &ModelDescription) -> Result<ReferenceResults, Error> {
+    let model = crate::Model::from_description(d)?;
+    let s = crate::stats::network_stats(&model)?;
+    let h = crate::homogenize::homogenize_elastic(&model, &Default::default())?;
+    Ok(ReferenceResults {
+        fibers: s.fibers,
+        elements: s.elements,
+        total_length: s.total_length,
+        volume_fraction: s.volume_fraction.unwrap_or(0.0),
+        contacts: h.contacts,
+        abd: h.abd,
+    })
+}
