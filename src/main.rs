@@ -209,6 +209,15 @@ enum GenerateKind {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Any family from a catalog parameter file (`family = "woven"|"geotextile"|"knitted"|
+    /// "nonwoven"` and the generator's fields, as in fixtures/cells/*.params.toml).
+    From {
+        /// Parameter file (TOML).
+        params: PathBuf,
+        /// Output model (.toml or .json).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// A plain-jersey knit of interlocked loops.
     Knitted {
         /// All parameters from a TOML file (the fields of `generate::Knit`).
@@ -778,6 +787,13 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             let t = std::time::Instant::now();
             let d = fibercell::generate::geotextile(&p)?;
             let label = format!("geotextile ({} families)", p.families.len());
+            finish_generated(&label, t, &d, &output)
+        }
+        GenerateKind::From { params, output } => {
+            let p = fibercell::generate::CellParams::read(&params)?;
+            let t = std::time::Instant::now();
+            let d = p.generate()?;
+            let label = d.name.clone().unwrap_or_default();
             finish_generated(&label, t, &d, &output)
         }
         GenerateKind::Knitted {

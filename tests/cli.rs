@@ -401,3 +401,108 @@ fn generate_nonwoven_writes_a_cell_that_stats_reads() {
     }
     assert!(!std::path::Path::new("x.toml").exists() && !std::path::Path::new("x.vtu").exists());
 }
+
+#[test]
+fn every_generator_writes_a_cell_and_prints_its_statistics() {
+    let out = tmpdir("generators");
+    std::fs::create_dir_all(&out).unwrap();
+    for (args, fibers) in [
+        (
+            vec!["woven", "--pattern", "twill:2/1", "--size", "6e-3,6e-3"],
+            6,
+        ),
+        (
+            vec![
+                "geotextile",
+                "--family",
+                "0,5e-3,5e-4",
+                "--family",
+                "90,5e-3,5e-4,1",
+            ],
+            4,
+        ),
+        (vec!["knitted", "--wales", "3", "--courses", "2"], 2),
+        (
+            vec!["from", "fixtures/cells/geotextile_small.params.toml"],
+            4,
+        ),
+    ] {
+        let path = out.join(format!("{}.toml", args[0]));
+        let mut all = vec!["generate"];
+        all.extend(&args);
+        all.extend(["-o", path.to_str().unwrap()]);
+        let o = run(&all);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            text.contains(&format!("{fibers} fibers")),
+            "{args:?}: {text}"
+        );
+        assert!(
+            text.contains("contacts") && text.contains("mean free segment"),
+            "{text}"
+        );
+        assert!(path.exists());
+    }
+    fails_saying(
+        &[
+            "generate",
+            "geotextile",
+            "--family",
+            "30,5e-3,5e-4",
+            "-o",
+            "x.toml",
+        ],
+        "families[0]",
+    );
+    fails_saying(
+        &["generate", "woven", "--pattern", "satin", "-o", "x.toml"],
+        "twill:OVER/UNDER",
+    );
+}
+
+#[test]
+fn convert_round_trips_through_abaqus_and_writes_paraview_files() {
+    let out = tmpdir("convert");
+    std::fs::create_dir_all(&out).unwrap();
+    let inp = out.join("cell.inp");
+    let toml = out.join("cell.toml");
+    for (from, to) in [
+        ("fixtures/cells/knitted_small.toml", inp.to_str().unwrap()),
+        (inp.to_str().unwrap(), toml.to_str().unwrap()),
+    ] {
+        let o = run(&["convert", from, to]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let a =
+        fibercell::io::read_description(Path::new("fixtures/cells/knitted_small.toml")).unwrap();
+    let b = fibercell::io::read_description(&toml).unwrap();
+    assert_eq!(a, b);
+    let pvd = out.join("cell.pvd");
+    let o = run(&[
+        "convert",
+        "fixtures/cells/knitted_small.toml",
+        pvd.to_str().unwrap(),
+    ]);
+    assert!(o.status.success());
+    let contacts = std::fs::read_to_string(out.join("cell_contacts.vtu")).unwrap();
+    assert!(
+        contacts.contains("NumberOfPoints=\"16\""),
+        "16 closed crossings"
+    );
+    assert!(std::fs::read_to_string(out.join("cell_fibers.vtu"))
+        .unwrap()
+        .contains("radius"));
+    fails_saying(
+        &["convert", "fixtures/ok_frame3d.toml", "x.stl"],
+        "unknown output format",
+    );
+    fails_saying(
+        &["convert", "fixtures/bad_nan_coordinate.toml", "x.inp"],
+        "node 2",
+    );
+}
