@@ -419,7 +419,7 @@ fn every_generator_writes_a_cell_and_prints_its_statistics() {
                 "--family",
                 "90,5e-3,5e-4,1",
             ],
-            4,
+            8, // four fibers and four connector beams
         ),
         (vec!["knitted", "--wales", "3", "--courses", "2"], 2),
         (
