@@ -283,3 +283,37 @@ fn a_finely_meshed_fiber_does_not_touch_itself_but_a_folded_one_does() {
     let straight = fibers(&[([0.0; 3], [1.0, 0.0, 0.0], r)], 400);
     assert!(find_candidates(&Model::from_description(&straight).unwrap(), r, None).is_empty());
 }
+
+/// A rigid rotation moves the two touching surface points together: the jump of every contact
+/// found by the search is at most |ω| × |initial gap| (the points are that far apart; here
+/// below 10⁻⁵ r) for u = ω × x, θ = ω — also for tilted normals on sloped elements (a jersey).
+/// The centerline jump would be ω × (r_I + r_II) n.
+#[test]
+fn a_rigid_rotation_gives_no_contact_jump() {
+    let omega = nalgebra::Vector3::new(0.3, -0.2, 0.5);
+    for d in [
+        fibercell::generate::crossing_grid(3, 2, 1e-2, 1e-3),
+        fibercell::generate::knitted(&fibercell::generate::Knit::default()).unwrap(),
+    ] {
+        let m = fibercell::Model::from_description(&d).unwrap();
+        let set = fibercell::contact::ContactSet::build(&m).unwrap();
+        assert!(!set.pairs.is_empty());
+        for pair in &set.pairs {
+            let mut q = nalgebra::SVector::<f64, 30>::zeros();
+            for (k, &n) in pair.jump.nodes.iter().enumerate() {
+                let u = omega.cross(&nalgebra::Vector3::from(m.nodes[n].x));
+                for i in 0..3 {
+                    q[6 * k + i] = u[i];
+                    q[6 * k + 3 + i] = omega[i];
+                }
+            }
+            let jump = pair.jump.b * q;
+            let r = m
+                .fibers
+                .iter()
+                .map(|f| f.section.radius)
+                .fold(f64::MAX, f64::min);
+            assert!(jump.norm() <= 1e-5 * omega.norm() * r, "{jump:?}");
+        }
+    }
+}

@@ -104,11 +104,13 @@ fn point_contacts_let_the_yarns_roll_and_rolling_resistance_holds_them() {
 
 #[test]
 fn the_incremental_curve_across_the_boundary_is_the_elastic_one() {
-    // κ22 is the case that loads these contacts (the wefts bend and drag the warps along y).
-    // Each weft is held by its two contacts only, whose forces balance, so once they slide the
-    // weft is free to slip along its axis: a real mechanism. With a bound above the peak force
-    // everything sticks and the incremental solution through the shifted jumps (forces and
-    // rolling moments in the reactions) must reproduce A^elas E at every increment.
+    // Under κ22 the wefts bend and the warps follow; every contact stays closed and sticks, and
+    // the incremental solution through the shifted jumps (forces and rolling moments in the
+    // reactions) must reproduce A^elas E at every increment. (With the objective surface-point
+    // jump these contacts carry almost nothing under any single macro strain that keeps them
+    // closed — in-plane shear and twist pull them open, and a weft held by open contacts is a
+    // mechanism — so the shifted jumps are checked mainly by the elastic ABD above, inside
+    // versus across the boundary.)
     let strain = [0.0, 0.0, 0.0, 0.0, 10.0, 0.0];
     let opts = SolveOptions::default();
     for x0 in [0.0, seam()] {
@@ -116,15 +118,15 @@ fn the_incremental_curve_across_the_boundary_is_the_elastic_one() {
         let elastic = homogenize_elastic(&m, &opts).unwrap();
         let c = curve(x0, 1.0, strain);
         assert!(c.switches.is_empty());
-        let peak = c
+        let closed = c
             .solution
             .contact_results
             .last()
             .unwrap()
             .iter()
-            .map(|r| r.tangential_magnitude)
-            .fold(0.0, f64::max);
-        assert!(peak > 1e-4, "the contacts carry the load ({peak} N)");
+            .filter(|r| r.state != fibercell::contact::ContactState::Open)
+            .count();
+        assert_eq!(closed, 4, "every contact stays closed");
         let scale = elastic.abd[4][4] * strain[4];
         for p in &c.points {
             for k in 0..6 {

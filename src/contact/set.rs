@@ -1,7 +1,9 @@
 //! The contact pairs of a model: searched candidates and explicit pairs, with their normals,
 //! tangent bases, gaps and penalties; initially penetrating pairs are counted and handled.
 
-use super::{find_candidates, jump_operator, tangent_basis, Candidate, ContactPair, ContactSide};
+use super::{
+    find_candidates, jump_operator, tangent_basis, Candidate, ContactPair, ContactSide, Jump,
+};
 use crate::cell::Periodicity;
 use crate::element::local_frame;
 use crate::model::{Model, ModelError, PenetrationSpec};
@@ -114,6 +116,39 @@ pub fn default_rotation_penalty(
     } else {
         0.0
     }
+}
+
+/// The jump of the two touching surface points x_I + r_I n and x_II − r_II n instead of the
+/// centerline points: [u]_s = [u] + θ_I × r_I n + θ_II × r_II n = B q − [n]× (r_I R_I + r_II R_II) q.
+/// A rigid rotation ω moves the centerline points (2r apart along n) relative to each other by
+/// ω × (r_I + r_II) n, tangentially: with the centerline jump of thesis Lemma 4.26 a sticking
+/// contact resists rigid rotations, which makes the cell problems depend on where the cell
+/// lies (the macro curvature fields rotate every point differently). The surface jump moves
+/// rigidly; its normal component, and so K_N, is unchanged (nᵀ [n]× = 0).
+fn surface_jump(model: &Model, mut jump: Jump, sides: [ContactSide; 2], n: &Vector3<f64>) -> Jump {
+    let radius = |s: ContactSide| {
+        side_elements(model, s).first().map_or(0.0, |&e| {
+            model.fibers[model.elements()[e].fiber].section.radius
+        })
+    };
+    let first_side_blocks = match sides[0] {
+        ContactSide::Node(_) => 1,
+        ContactSide::Point { .. } => 2,
+    };
+    let cross = nalgebra::Matrix3::new(0.0, -n[2], n[1], n[2], 0.0, -n[0], -n[1], n[0], 0.0);
+    // jump.r holds +R_I for side I's nodes and −R_II for side II's.
+    for k in 0..jump.nodes.len() {
+        let lever = if k < first_side_blocks {
+            -radius(sides[0])
+        } else {
+            radius(sides[1])
+        };
+        let r_block = jump.r.fixed_view::<3, 6>(0, 6 * k).into_owned();
+        let add = cross * r_block * lever;
+        let mut b_block = jump.b.fixed_view_mut::<3, 6>(0, 6 * k);
+        b_block += add;
+    }
+    jump
 }
 
 /// A contact point at an element end is the node itself (the interpolation there is exactly the
@@ -263,12 +298,18 @@ impl ContactSet {
                 gap,
                 penalties: [pn, pt, pr],
             } = pair;
-            let jump = jump_operator(model, sides[0], sides[1], shift).ok_or_else(|| {
+            let mut_jump = jump_operator(model, sides[0], sides[1], shift).ok_or_else(|| {
                 ModelError::InvalidContact {
                     item: format!("contact pair {}", k + 1),
                     message: "its two sides share a node".into(),
                 }
             })?;
+            // Found by the search: the jump of the touching surface points (objective).
+            let jump = if kind == "search" {
+                surface_jump(model, mut_jump, sides, &normal)
+            } else {
+                mut_jump
+            };
             let preferred = match sides[0] {
                 ContactSide::Point { element, .. } => {
                     let e = model.elements()[element];
