@@ -5,6 +5,8 @@
 //! The square weave is invariant under the 90° rotation that swaps warps and wefts, so
 //! A11 = A22 and D11 = D22.
 
+mod common;
+use common::grid_abd::{assert_abd, elastic_abd};
 use fibercell::generate::{weave, Weave, WeavePattern};
 use fibercell::homogenize::{homogenize_elastic, Homogenized};
 use fibercell::solve::SolveOptions;
@@ -166,5 +168,33 @@ fn bad_weave_parameters_name_the_field() {
     ] {
         let err = weave(&bad).unwrap_err().to_string();
         assert!(err.contains(field), "{err}");
+    }
+}
+
+#[test]
+fn the_plain_weave_is_mirror_symmetric_and_independent_of_fiber_direction() {
+    // Reflecting x (with a shift of half a cell in y) maps the plain weave onto itself, so every
+    // coupling of (ε11, ε22, κ11, κ22) with (γ12, κ12) vanishes; and reversing the node order of
+    // every yarn describes the same cell. Both hold only if a crossover, where the discretized
+    // yarns are equally close on both sides of the crossover nodes, is placed symmetrically.
+    let d = weave(&Weave::default()).unwrap();
+    let mut reversed = d.clone();
+    for f in &mut reversed.fibers {
+        f.nodes.reverse();
+    }
+    let a = elastic_abd(&d);
+    assert_abd(&elastic_abd(&reversed), &a, 1e-9);
+    for r in 0..6 {
+        for c in 0..6 {
+            let scale = (a[r][r] * a[c][c]).sqrt();
+            let odd = (r == 2 || r == 5) != (c == 2 || c == 5);
+            if odd {
+                assert!(
+                    a[r][c].abs() <= 1e-9 * scale,
+                    "ABD[{r}][{c}] = {:e}",
+                    a[r][c]
+                );
+            }
+        }
     }
 }

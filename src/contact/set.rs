@@ -210,6 +210,8 @@ fn merge_duplicates(
             .then(a.shift.cmp(&b.shift))
     });
     let mut kept: Vec<Candidate> = Vec::with_capacity(found.len());
+    // The candidates merged into each kept one.
+    let mut twins: Vec<Vec<Candidate>> = Vec::with_capacity(found.len());
     let mut group_start = 0;
     for c in found {
         if kept.get(group_start).is_some_and(|g| key(g) != key(&c)) {
@@ -218,7 +220,7 @@ fn merge_duplicates(
         let reach = 2.0 * (c.distance - c.gap);
         let pa = point(c.elements[0], c.xi[0], [0, 0]);
         let pb = point(c.elements[1], c.xi[1], c.shift);
-        let duplicate = kept[group_start..].iter().any(|k| {
+        let duplicate = kept[group_start..].iter().position(|k| {
             let qa = point(k.elements[0], k.xi[0], [0, 0]);
             let qb = point(k.elements[1], k.xi[1], k.shift);
             // Compare whichever way round the pair was found: the same first point (modulo
@@ -227,12 +229,83 @@ fn merge_duplicates(
             let swapped = wrap(pa - qb).norm().max(((pb - pa) - (qa - qb)).norm());
             same.min(swapped) < reach
         });
-        if !duplicate {
-            kept.push(c);
+        match duplicate {
+            None => {
+                kept.push(c);
+                twins.push(Vec::new());
+            }
+            Some(i) => twins[group_start + i].push(c),
+        }
+    }
+    for (k, twins) in kept.iter_mut().zip(&twins) {
+        if let Some(at_nodes) = straddled_nodes(model, period, k, twins) {
+            *k = at_nodes;
         }
     }
     kept.sort_by_key(|c| (c.elements, c.shift));
     kept
+}
+
+/// A crossing at a node of each fiber where both polylines kink (a woven crossover) is closest
+/// not at the nodes but a little way along the adjacent elements (a chord cuts inside the
+/// curve), at equally close element pairs on both sides of each node: keeping one of them
+/// would break the symmetry of the crossing. When the equally close candidates (within 10⁻⁹)
+/// lie on both elements at a node of each fiber, the contact is placed at the two nodes.
+fn straddled_nodes(
+    model: &Model,
+    period: [f64; 2],
+    kept: &Candidate,
+    twins: &[Candidate],
+) -> Option<Candidate> {
+    let els = model.elements();
+    let fiber = |e: usize| els[e].fiber;
+    let tol = 1e-9 * kept.distance.abs().max(f64::MIN_POSITIVE);
+    // The near-equal candidates, oriented like `kept` (side I on kept's first fiber).
+    let mut same: Vec<([usize; 2], [i32; 2])> = vec![(kept.elements, kept.shift)];
+    for t in twins.iter().filter(|t| t.distance <= kept.distance + tol) {
+        if fiber(t.elements[0]) == fiber(kept.elements[0]) {
+            same.push((t.elements, t.shift));
+        } else {
+            same.push(([t.elements[1], t.elements[0]], [-t.shift[0], -t.shift[1]]));
+        }
+    }
+    if same.len() < 2 || same.iter().any(|(_, s)| *s != kept.shift) {
+        return None;
+    }
+    // The node shared by two different elements of one side, if any.
+    let shared = |side: usize| -> Option<(usize, usize)> {
+        for (a, _) in &same {
+            for (b, _) in &same {
+                let (ea, eb) = (els[a[side]], els[b[side]]);
+                if a[side] != b[side] && ea.nodes[1] == eb.nodes[0] {
+                    return Some((a[side], ea.nodes[1]));
+                }
+            }
+        }
+        None
+    };
+    let ((ea, na), (eb, nb)) = (shared(0)?, shared(1)?);
+    let x = |n: usize| Vector3::from(model.nodes[n].x);
+    let offset = Vector3::new(
+        f64::from(kept.shift[0]) * period[0],
+        f64::from(kept.shift[1]) * period[1],
+        0.0,
+    );
+    let d = x(nb) + offset - x(na);
+    let distance = d.norm();
+    if distance <= 0.0 {
+        return None;
+    }
+    let radius = |e: usize| model.fibers[fiber(e)].section.radius;
+    let n = d / distance;
+    Some(Candidate {
+        elements: [ea, eb],
+        shift: kept.shift,
+        xi: [1.0, 1.0],
+        distance,
+        gap: distance - radius(ea) - radius(eb),
+        normal: [n[0], n[1], n[2]],
+    })
 }
 
 impl ContactSet {

@@ -32,3 +32,13 @@ pub fn assert_abd(got: &[[f64; 6]; 6], want: &[[f64; 6]; 6], tol: f64) {
         }
     }
 }
+
+/// The elastic ABD of a cell with the default solver.
+pub fn elastic_abd(d: &fibercell::model::ModelDescription) -> [[f64; 6]; 6] {
+    fibercell::homogenize::homogenize_elastic(
+        &fibercell::Model::from_description(d).expect("valid cell"),
+        &fibercell::solve::SolveOptions::default(),
+    )
+    .expect("homogenizes")
+    .abd
+}
