@@ -588,6 +588,11 @@ fn homogenize(
         100.0 * h.pressure.coverage,
         b[0], b[1], b[2], b[3], b[4], b[5]
     );
+    let t = &h.timings;
+    println!(
+        "time (s): setup {:.3}  assembly {:.3}  analysis {:.3}  factorization {:.3}  pressure load {:.3}  7 solves {:.3}  post {:.3}  total {:.3}",
+        t.setup, t.assembly, t.analysis, t.factorization, t.pressure_load, t.solve, t.post, t.total
+    );
     Ok(())
 }
 

@@ -48,6 +48,30 @@ pub struct Homogenized {
     /// Cell geometry.
     #[serde(skip)]
     pub geometry: Option<CellGeometry>,
+    /// Wall-clock time of each stage.
+    pub timings: HomogenizeTimings,
+}
+
+/// Wall-clock seconds of the stages of [`homogenize_elastic`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct HomogenizeTimings {
+    /// Boundary pairing, contact search (with periodic images), percolation check and the
+    /// sparsity pattern.
+    pub setup: f64,
+    /// Value fill of K (elements and contacts) and of the driver couplings.
+    pub assembly: f64,
+    /// Symbolic analysis (ordering and elimination tree).
+    pub analysis: f64,
+    /// Numeric factorization.
+    pub factorization: f64,
+    /// The pressure load Θ.
+    pub pressure_load: f64,
+    /// The seven solves (six cell problems and Θ) with their residual check.
+    pub solve: f64,
+    /// ABD, moduli and the expanded cell-problem solutions.
+    pub post: f64,
+    /// Everything.
+    pub total: f64,
 }
 
 /// The response of the cell to a unit out-of-plane pressure (1 Pa pushing the top face down,
@@ -72,15 +96,28 @@ pub struct PressureResponse {
 /// Solves the six unit cell problems of `model` (which needs a `[cell]`) and returns ABD and
 /// the derived constants.
 pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homogenized, Error> {
+    let start = std::time::Instant::now();
+    let mut clock = start;
+    let mut lap = || {
+        let now = std::time::Instant::now();
+        let t = (now - clock).as_secs_f64();
+        clock = now;
+        t
+    };
+    let mut timings = HomogenizeTimings::default();
     let sys = PeriodicSystem::new(model)?;
+    timings.setup = lap();
     let vals = sys.assemble(model);
     let n = sys.n_free();
     let a = sys.pattern.matrix(&vals.values)?;
+    timings.assembly = lap();
     let mut solver = make_solver(options.solver, &options.ordering, Vec::new())?;
     let node_dof = |c: usize| (c < n).then(|| sys.node_dof(c));
     let locate = |e: SolverError| locate(e, model, &node_dof);
     solver.analyze(a).map_err(locate)?;
+    timings.analysis = lap();
     solver.factorize(a).map_err(locate)?;
+    timings.factorization = lap();
     let g = sys.periodicity.geometry;
     let area = g.area();
     let disc = &sys.discretization;
@@ -120,8 +157,10 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
             }
         }
     }
+    timings.pressure_load = lap();
     let (x, report) = solve_checked(solver.as_mut(), a, &rhs, 7).map_err(locate)?;
     check_backward_error(options, report.backward_error, "cell problems")?;
+    timings.solve = lap();
     let theta = &x[6 * n..7 * n];
     // Driver reaction (internal force minus the load on the drivers) plus the load virial: the
     // volume average of the stress, as (5.4) defines it.
@@ -155,6 +194,8 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
             sys.expand(&x[k * n..(k + 1) * n], &e)
         })
         .collect();
+    timings.post = lap();
+    timings.total = start.elapsed().as_secs_f64();
     Ok(Homogenized {
         moduli: ThesisModuli::from_abd(&abd),
         orthotropic: Orthotropic::from_abd(&abd, g.thickness),
@@ -170,5 +211,6 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
         pressure,
         cases,
         geometry: Some(g),
+        timings,
     })
 }
