@@ -664,7 +664,7 @@ fn curve(
 }
 
 fn generate(kind: GenerateKind) -> Result<(), Error> {
-    use fibercell::generate::{FiberAmount, LengthDistribution, NonWoven};
+    use fibercell::generate::{CellParams, FiberAmount, LengthDistribution, NonWoven};
     match kind {
         GenerateKind::Nonwoven {
             params,
@@ -746,10 +746,7 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             radius,
             output,
         } => {
-            let mut p = match params {
-                Some(path) => io::read_toml_file::<fibercell::generate::Weave>(&path)?,
-                None => fibercell::generate::Weave::default(),
-            };
+            let mut p: fibercell::generate::Weave = params_or_default(params.as_deref())?;
             if let Some(v) = pattern {
                 p.pattern = v;
             }
@@ -759,10 +756,7 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             if let Some(v) = radius {
                 p.radius = v;
             }
-            let t = std::time::Instant::now();
-            let d = fibercell::generate::weave(&p)?;
-            let label = d.name.clone().unwrap_or_default();
-            finish_generated(&label, t, &d, &output)
+            generate_cell(CellParams::Woven(p), &output)
         }
         GenerateKind::Geotextile {
             params,
@@ -772,11 +766,7 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             element_length,
             output,
         } => {
-            use fibercell::generate::{Geotextile, LayerJunction};
-            let mut p = match params {
-                Some(path) => io::read_toml_file::<Geotextile>(&path)?,
-                None => Geotextile::default(),
-            };
+            let mut p: fibercell::generate::Geotextile = params_or_default(params.as_deref())?;
             if let Some(v) = size {
                 p.size = v;
             }
@@ -784,23 +774,14 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
                 p.families = families;
             }
             if let Some(mu) = contact_mu {
-                p.layer_junction = LayerJunction::Contact { mu };
+                p.layer_junction = fibercell::generate::LayerJunction::Contact { mu };
             }
             if let Some(v) = element_length {
                 p.element_length = v;
             }
-            let t = std::time::Instant::now();
-            let d = fibercell::generate::geotextile(&p)?;
-            let label = format!("geotextile ({} families)", p.families.len());
-            finish_generated(&label, t, &d, &output)
+            generate_cell(CellParams::Geotextile(p), &output)
         }
-        GenerateKind::From { params, output } => {
-            let p = fibercell::generate::CellParams::read(&params)?;
-            let t = std::time::Instant::now();
-            let d = p.generate()?;
-            let label = d.name.clone().unwrap_or_default();
-            finish_generated(&label, t, &d, &output)
-        }
+        GenerateKind::From { params, output } => generate_cell(CellParams::read(&params)?, &output),
         GenerateKind::Knitted {
             params,
             wales,
@@ -808,10 +789,7 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             radius,
             output,
         } => {
-            let mut p = match params {
-                Some(path) => io::read_toml_file::<fibercell::generate::Knit>(&path)?,
-                None => fibercell::generate::Knit::default(),
-            };
+            let mut p: fibercell::generate::Knit = params_or_default(params.as_deref())?;
             if let Some(v) = wales {
                 p.wales = v;
             }
@@ -821,12 +799,32 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             if let Some(v) = radius {
                 p.radius = v;
             }
-            let t = std::time::Instant::now();
-            let d = fibercell::generate::knitted(&p)?;
-            let label = d.name.clone().unwrap_or_default();
-            finish_generated(&label, t, &d, &output)
+            generate_cell(CellParams::Knitted(p), &output)
         }
     }
+}
+
+/// Generator parameters from a TOML file, or the generator's defaults.
+fn params_or_default<T: serde::de::DeserializeOwned + Default>(
+    path: Option<&Path>,
+) -> Result<T, Error> {
+    match path {
+        Some(path) => io::read_toml_file(path),
+        None => Ok(T::default()),
+    }
+}
+
+/// Generates a cell of any family, writes it and prints its statistics.
+fn generate_cell(params: fibercell::generate::CellParams, output: &Path) -> Result<(), Error> {
+    let t = std::time::Instant::now();
+    let d = params.generate()?;
+    let label = match &params {
+        fibercell::generate::CellParams::Geotextile(g) => {
+            format!("geotextile ({} families)", g.families.len())
+        }
+        _ => d.name.clone().unwrap_or_default(),
+    };
+    finish_generated(&label, t, &d, output)
 }
 
 /// Writes a generated cell and prints its statistics.

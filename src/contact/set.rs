@@ -65,13 +65,35 @@ fn transverse_stiffness(model: &Model, e: usize) -> f64 {
     12.0 * model.materials[f.material].young * f.section.second_moment() / l.powi(3)
 }
 
-fn side_elements(model: &Model, side: ContactSide) -> Vec<usize> {
-    match side {
-        ContactSide::Point { element, .. } => vec![element],
-        ContactSide::Node(n) => (0..model.elements().len())
-            .filter(|&e| model.elements()[e].nodes.contains(&n))
-            .collect(),
+/// The elements at each node, built once per contact set (a side that is a node looks its
+/// elements up here instead of scanning every element).
+struct NodeElements(Vec<Vec<usize>>);
+
+impl NodeElements {
+    fn new(model: &Model) -> Self {
+        let mut at = vec![Vec::new(); model.nodes.len()];
+        for (e, el) in model.elements().iter().enumerate() {
+            for &n in &el.nodes {
+                at[n].push(e);
+            }
+        }
+        NodeElements(at)
     }
+
+    /// The elements of each side: its element, or every element at its node.
+    fn of(&self, sides: [ContactSide; 2]) -> [Vec<usize>; 2] {
+        sides.map(|side| match side {
+            ContactSide::Point { element, .. } => vec![element],
+            ContactSide::Node(n) => self.0[n].clone(),
+        })
+    }
+}
+
+/// Radius of the fiber of a side's first element (0 for a side without elements).
+fn side_radius(model: &Model, elements: &[usize]) -> f64 {
+    elements.first().map_or(0.0, |&e| {
+        model.fibers[model.elements()[e].fiber].section.radius
+    })
 }
 
 fn side_point(model: &Model, side: ContactSide) -> Vector3<f64> {
@@ -91,25 +113,29 @@ fn side_point(model: &Model, side: ContactSide) -> Vector3<f64> {
 /// Default penalty: 1000 × the largest transverse stiffness 12EI/L³ of the elements on either
 /// side, so the penalty compliance is a thousandth of the fibers' own bending compliance.
 pub fn default_penalty(model: &Model, sides: [ContactSide; 2]) -> f64 {
+    penalty_of_elements(model, &NodeElements::new(model).of(sides))
+}
+
+fn penalty_of_elements(model: &Model, elements: &[Vec<usize>; 2]) -> f64 {
     1000.0
-        * sides
+        * elements
             .iter()
-            .flat_map(|&s| side_elements(model, s))
-            .map(|e| transverse_stiffness(model, e))
+            .flatten()
+            .map(|&e| transverse_stiffness(model, e))
             .fold(0.0, f64::max)
 }
 
 /// Default rolling resistance p_N a²/4, with a half the smaller fiber radius of the two sides:
 /// the rotational stiffness of the normal penalty spread over a disc of radius a.
-pub fn default_rotation_penalty(
+fn rotation_penalty_of_elements(
     model: &Model,
-    sides: [ContactSide; 2],
+    elements: &[Vec<usize>; 2],
     penalty_normal: f64,
 ) -> f64 {
-    let radius = sides
+    let radius = elements
         .iter()
-        .flat_map(|&s| side_elements(model, s))
-        .map(|e| model.fibers[model.elements()[e].fiber].section.radius)
+        .flatten()
+        .map(|&e| model.fibers[model.elements()[e].fiber].section.radius)
         .fold(f64::INFINITY, f64::min);
     if radius.is_finite() {
         penalty_normal * (0.5 * radius).powi(2) / 4.0
@@ -125,12 +151,17 @@ pub fn default_rotation_penalty(
 /// contact resists rigid rotations, which makes the cell problems depend on where the cell
 /// lies (the macro curvature fields rotate every point differently). The surface jump moves
 /// rigidly; its normal component, and so K_N, is unchanged (nᵀ [n]× = 0).
-fn surface_jump(model: &Model, mut jump: Jump, sides: [ContactSide; 2], n: &Vector3<f64>) -> Jump {
-    let radius = |s: ContactSide| {
-        side_elements(model, s).first().map_or(0.0, |&e| {
-            model.fibers[model.elements()[e].fiber].section.radius
-        })
-    };
+fn surface_jump(
+    model: &Model,
+    mut jump: Jump,
+    sides: [ContactSide; 2],
+    elements: &[Vec<usize>; 2],
+    n: &Vector3<f64>,
+) -> Jump {
+    let radii = [
+        side_radius(model, &elements[0]),
+        side_radius(model, &elements[1]),
+    ];
     let first_side_blocks = match sides[0] {
         ContactSide::Node(_) => 1,
         ContactSide::Point { .. } => 2,
@@ -139,9 +170,9 @@ fn surface_jump(model: &Model, mut jump: Jump, sides: [ContactSide; 2], n: &Vect
     // jump.r holds +R_I for side I's nodes and −R_II for side II's.
     for k in 0..jump.nodes.len() {
         let lever = if k < first_side_blocks {
-            -radius(sides[0])
+            -radii[0]
         } else {
-            radius(sides[1])
+            radii[1]
         };
         let r_block = jump.r.fixed_view::<3, 6>(0, 6 * k).into_owned();
         let add = cross * r_block * lever;
@@ -362,6 +393,7 @@ impl ContactSet {
             });
         }
         let mut set = ContactSet::default();
+        let at_nodes = NodeElements::new(model);
         for (k, pair) in raw.into_iter().enumerate() {
             let RawPair {
                 kind,
@@ -371,7 +403,8 @@ impl ContactSet {
                 gap,
                 penalties: [pn, pt, pr],
             } = pair;
-            let mut_jump = jump_operator(model, sides[0], sides[1], shift).ok_or_else(|| {
+            let elements = at_nodes.of(sides);
+            let centerline = jump_operator(model, sides[0], sides[1], shift).ok_or_else(|| {
                 ModelError::InvalidContact {
                     item: format!("contact pair {}", k + 1),
                     message: "its two sides share a node".into(),
@@ -379,9 +412,9 @@ impl ContactSet {
             })?;
             // Found by the search: the jump of the touching surface points (objective).
             let jump = if kind == "search" {
-                surface_jump(model, mut_jump, sides, &normal)
+                surface_jump(model, centerline, sides, &elements, &normal)
             } else {
-                mut_jump
+                centerline
             };
             let preferred = match sides[0] {
                 ContactSide::Point { element, .. } => {
@@ -393,11 +426,11 @@ impl ContactSet {
             };
             let penalty_normal = pn
                 .or(settings.penalty_normal)
-                .unwrap_or_else(|| default_penalty(model, sides));
+                .unwrap_or_else(|| penalty_of_elements(model, &elements));
             let penalty_tangent = pt.or(settings.penalty_tangent).unwrap_or(penalty_normal);
             let penalty_rotation = pr
                 .or(settings.penalty_rotation)
-                .unwrap_or_else(|| default_rotation_penalty(model, sides, penalty_normal));
+                .unwrap_or_else(|| rotation_penalty_of_elements(model, &elements, penalty_normal));
             let mut gap = gap;
             if gap < 0.0 {
                 set.penetration.count += 1;
@@ -407,8 +440,8 @@ impl ContactSet {
                     set.penetration.adjusted = true;
                 }
             }
-            let fiber_of = |s: ContactSide| {
-                side_elements(model, s)
+            let fiber_of = |side: usize| {
+                elements[side]
                     .first()
                     .map_or(0, |&e| model.fibers[model.elements()[e].fiber].id)
             };
@@ -417,7 +450,7 @@ impl ContactSet {
                 kind,
                 sides,
                 shift,
-                fibers: [fiber_of(sides[0]), fiber_of(sides[1])],
+                fibers: [fiber_of(0), fiber_of(1)],
                 point: [p[0], p[1], p[2]],
             });
             set.pairs.push(ContactPair {
