@@ -5,6 +5,11 @@
 //! trial tangential force p_T (Eᵀ B q − s) lies within the friction bound (μN or G), otherwise
 //! slip at the bound along the trial direction — until no state changes.
 //!
+//! A contact that changes its state or slip direction four times within one increment (the
+//! discrete penalty problem can have no consistent state for it: e.g. closed it is pulled apart,
+//! open it penetrates) is held in its state for the rest of the increment; the count is
+//! reported per increment.
+//!
 //! The pattern (elements ∪ all candidate contact blocks) and each backend's symbolic analysis are
 //! built once; a factorization is redone only when the assembled values changed. Systems with a
 //! Coulomb-sliding contact are nonsymmetric and go to LU, all others to the chosen symmetric
@@ -14,7 +19,9 @@ use super::static_solve::{check_backward_error, locate};
 use super::{check_supported_with, make_solver, SolveOptions, SolverKind};
 use crate::assembly::{element_stiffness, Assembler, DofMap, Pattern, NO_SLOT};
 use crate::constraints::{internal_forces, Discretization, Reaction};
-use crate::contact::{BlockVector, ContactPair, ContactSet, ContactSide, ContactState, Friction};
+use crate::contact::{
+    BlockMatrix, BlockVector, ContactPair, ContactSet, ContactSide, ContactState, Friction,
+};
 use crate::model::Model;
 use crate::Error;
 use fibercell_solver::{solve_checked, LinearSolver, SolverError};
@@ -49,6 +56,18 @@ pub struct IncrementalOptions {
     pub fixed_slip_direction: bool,
     /// Called after every increment (e.g. to drive a progress bar).
     pub progress: Option<Progress>,
+    /// Relative stiffness ε of the stabilizing springs (default 0: none). An open contact keeps
+    /// ε (K_N + K_T^st + K_R) and a sliding one ε K_T^st, linear springs on the contact jump with
+    /// no prestress. A fiber that loses all its closed contacts (a rattler) or whose contacts all
+    /// slide one way is otherwise a mechanism and the system is singular; with ε ≈ 1e-8 it
+    /// follows its neighbours and the springs carry forces of relative size ε, included in the
+    /// reactions.
+    pub stabilization: f64,
+    /// A fixed contact topology: initially closed contacts never open (the normal spring is
+    /// bilateral, N may be negative, a tension) and open ones never close; only stick and slip
+    /// evolve, with a Coulomb bound μ max(N, 0). A model of bonded or consolidated mats, whose
+    /// just-touching contacts would otherwise open under the smallest strain and chatter.
+    pub bonded: bool,
 }
 
 impl Default for IncrementalOptions {
@@ -60,6 +79,8 @@ impl Default for IncrementalOptions {
             path: None,
             fixed_slip_direction: false,
             progress: None,
+            stabilization: 0.0,
+            bonded: false,
         }
     }
 }
@@ -91,6 +112,10 @@ pub struct IncrementRecord {
     pub macro_reaction: Option<[f64; 6]>,
     /// Energy dissipated by sliding since the start, Σ F_t · Δs (J).
     pub dissipated: f64,
+    /// Contacts that chattered (changed state or slip direction 4 times in this increment: the
+    /// discrete penalty problem can have no consistent state for them) and were then held in
+    /// their state for the rest of it.
+    pub held: usize,
     /// Backend of the last solve.
     pub backend: String,
     /// Backward error of the last solve.
@@ -148,6 +173,37 @@ struct Trial {
     trial_norm: f64,
 }
 
+/// The contact law of a run: friction, and whether initially closed contacts are bonded
+/// (never open).
+#[derive(Clone, Copy, Debug)]
+struct Law {
+    friction: Friction,
+    bonded: bool,
+}
+
+/// State switches of one contact within an increment after which it is held in its state.
+const CHATTER_SWITCHES: usize = 4;
+
+/// The trial `t` of a contact held in `state` with slip direction `direction` (a contact that
+/// chattered): forces consistent with that state (stick: the trial force; slip: the bound along
+/// `direction`; open: none).
+fn hold(mut t: Trial, state: ContactState, direction: Vector2<f64>) -> Trial {
+    let trial = t.direction * t.trial_norm;
+    match state {
+        ContactState::Open => {
+            t.normal_force = 0.0;
+            t.tangential = Vector2::zeros();
+        }
+        ContactState::Stick => t.tangential = trial,
+        ContactState::Slip => {
+            t.direction = direction;
+            t.tangential = direction * t.bound;
+        }
+    }
+    t.state = state;
+    t
+}
+
 /// Return mapping of one contact for the block displacement `q` and committed slip `s`.
 /// `previous` is the state the system was solved with: within the tolerances (`length_tol` on
 /// the penetration, a relative 1e-10 on the friction bound) a contact keeps it, so a contact
@@ -156,7 +212,7 @@ struct Trial {
 /// contact that carries nothing would otherwise slide in a direction set by noise).
 fn classify(
     pair: &ContactPair,
-    friction: Friction,
+    law: Law,
     q: &BlockVector,
     slip: &Vector2<f64>,
     previous: (ContactState, Vector2<f64>),
@@ -164,6 +220,7 @@ fn classify(
     fixed_direction: Option<Vector2<f64>>,
 ) -> Trial {
     let (previous, previous_direction) = previous;
+    let friction = law.friction;
     let kin = pair.kinematics(q);
     let mut t = Trial {
         state: ContactState::Open,
@@ -176,7 +233,9 @@ fn classify(
         trial_norm: 0.0,
     };
     let closed_before = previous != ContactState::Open;
-    let closes = if closed_before {
+    let closes = if law.bonded {
+        pair.gap <= 0.0
+    } else if closed_before {
         kin.penetration > -length_tol
     } else {
         kin.penetration > length_tol
@@ -184,7 +243,11 @@ fn classify(
     if !closes {
         return t;
     }
-    t.normal_force = pair.penalty_normal * kin.penetration.max(0.0);
+    t.normal_force = if law.bonded {
+        pair.penalty_normal * kin.penetration
+    } else {
+        pair.penalty_normal * kin.penetration.max(0.0)
+    };
     let trial = (kin.tangential - slip) * pair.penalty_tangent;
     let norm = trial.norm();
     t.trial_norm = norm;
@@ -195,7 +258,7 @@ fn classify(
     };
     t.bound = match friction {
         Friction::None => 0.0,
-        Friction::Coulomb { mu } => mu * t.normal_force,
+        Friction::Coulomb { mu } => mu * t.normal_force.max(0.0),
         Friction::Tresca { bound } => bound,
     };
     if closed_before && friction != Friction::None && norm <= pair.penalty_tangent * length_tol {
@@ -252,6 +315,16 @@ fn describe(model: &Model, set: &ContactSet, i: usize) -> String {
         side(o.sides[0]),
         side(o.sides[1])
     )
+}
+
+/// The unscaled stabilizing spring of a contact in `state` (see
+/// [`IncrementalOptions::stabilization`]): K_N + K_T^st + K_R when open, K_T^st when sliding.
+fn stabilizer(pair: &ContactPair, state: ContactState) -> BlockMatrix {
+    let (kt, _) = pair.stick(&Vector2::zeros());
+    match state {
+        ContactState::Open => pair.normal().0 + kt + pair.rotation(),
+        _ => kt,
+    }
 }
 
 /// What an assembled matrix was built from: symmetry, states, slip directions, k⊥ of each contact.
@@ -519,10 +592,18 @@ pub(crate) fn run_incremental(
         v
     };
 
+    let stabilization = opts.stabilization;
+    if !(stabilization.is_finite() && stabilization >= 0.0) {
+        return Err(Error::InvalidOption(format!(
+            "stabilization = {stabilization} must be finite and ≥ 0"
+        )));
+    }
     let mut dissipated = 0.0;
     for (step, &alpha) in (1..).zip(&path) {
         let mut factorizations = 0;
         let mut converged = None;
+        // State switches per contact in this increment (chatter detection).
+        let mut switches = vec![0usize; pairs.len()];
         for iteration in 1..=opts.max_state_iterations {
             // Assemble K + K_N + K_T and α F + F_N + F_T for the current states.
             values.copy_from_slice(&k_elastic);
@@ -530,30 +611,41 @@ pub(crate) fn run_incremental(
             let mut closed: Vec<&[usize]> = Vec::new();
             let mut nonsymmetric = false;
             for (i, pair) in pairs.iter().enumerate() {
-                if states[i] == ContactState::Open {
-                    continue;
-                }
-                closed.push(&set.pairs[i].jump.nodes);
-                let (mut k, mut f) = pair.normal();
-                let (kt, ft) = match states[i] {
-                    ContactState::Stick => pair.stick(&slips[i]),
-                    _ => {
-                        nonsymmetric |= matches!(friction, Friction::Coulomb { mu } if mu > 0.0);
-                        let (mut k, mut f) = pair.slip(friction, &directions[i]);
-                        if perpendicular[i].0 > 0.0 {
-                            let (kp, fp) = pair.slip_perpendicular(
-                                &directions[i],
-                                perpendicular[i].0,
-                                &perpendicular[i].1,
-                            );
-                            k += kp;
-                            f += fp;
-                        }
+                let (k, f) = match states[i] {
+                    ContactState::Open if stabilization > 0.0 => (
+                        stabilizer(pair, states[i]) * stabilization,
+                        BlockVector::zeros(),
+                    ),
+                    ContactState::Open => continue,
+                    state => {
+                        closed.push(&set.pairs[i].jump.nodes);
+                        let (mut k, mut f) = pair.normal();
+                        let (kt, ft) = match state {
+                            ContactState::Stick => pair.stick(&slips[i]),
+                            _ => {
+                                nonsymmetric |=
+                                    matches!(friction, Friction::Coulomb { mu } if mu > 0.0);
+                                let (mut k, mut f) = pair.slip(friction, &directions[i]);
+                                if perpendicular[i].0 > 0.0 {
+                                    let (kp, fp) = pair.slip_perpendicular(
+                                        &directions[i],
+                                        perpendicular[i].0,
+                                        &perpendicular[i].1,
+                                    );
+                                    k += kp;
+                                    f += fp;
+                                }
+                                if stabilization > 0.0 {
+                                    k += stabilizer(pair, state) * stabilization;
+                                }
+                                (k, f)
+                            }
+                        };
+                        k += kt + pair.rotation();
+                        f += ft;
                         (k, f)
                     }
                 };
-                k += kt + pair.rotation();
-                f += ft;
                 let m = pair.size();
                 let slots = pattern.extra_slots(i);
                 let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
@@ -616,13 +708,27 @@ pub(crate) fn run_incremental(
                 .map(|(i, p)| {
                     classify(
                         p,
-                        friction,
+                        Law {
+                            friction,
+                            bonded: opts.bonded,
+                        },
                         &gather(&q, &p.jump.nodes),
                         &slips[i],
                         (states[i], directions[i]),
                         length_tol,
                         fixed[i],
                     )
+                })
+                .collect();
+            let trials: Vec<Trial> = trials
+                .into_iter()
+                .enumerate()
+                .map(|(i, t)| {
+                    if switches[i] >= CHATTER_SWITCHES {
+                        hold(t, states[i], directions[i])
+                    } else {
+                        t
+                    }
                 })
                 .collect();
             let changed: Vec<usize> = (0..pairs.len())
@@ -646,6 +752,7 @@ pub(crate) fn run_incremental(
                 });
             }
             for &i in &changed {
+                switches[i] += 1;
                 states[i] = trials[i].state;
                 directions[i] = trials[i].direction;
             }
@@ -680,9 +787,12 @@ pub(crate) fn run_incremental(
                 pair.tangents[0] * t.tangential[0] + pair.tangents[1] * t.tangential[1];
             let force = pair.normal * t.normal_force + ft;
             let mut fq = pair.jump.b.transpose() * force;
+            let q_block = gather(&q, &pair.jump.nodes);
             if t.state != ContactState::Open {
-                let q_block = gather(&q, &pair.jump.nodes);
                 fq += pair.jump.r.transpose() * pair.rotation_moment(&q_block);
+            }
+            if stabilization > 0.0 && t.state != ContactState::Stick {
+                fq += stabilizer(pair, t.state) * q_block * stabilization;
             }
             for (k, &n) in pair.jump.nodes.iter().enumerate() {
                 for d in 0..6 {
@@ -737,6 +847,7 @@ pub(crate) fn run_incremental(
             reaction,
             macro_reaction,
             dissipated,
+            held: switches.iter().filter(|&&n| n >= CHATTER_SWITCHES).count(),
             backend: backend.to_string(),
             backward_error: bwd,
         });
