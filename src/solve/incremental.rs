@@ -15,7 +15,7 @@
 //! Coulomb-sliding contact are nonsymmetric and go to LU, all others to the chosen symmetric
 //! backend.
 
-use super::static_solve::{check_backward_error, locate};
+use super::static_solve::{backward_tolerance, check_backward_error, locate};
 use super::{check_supported_with, make_solver, SolveOptions, SolverKind};
 use crate::assembly::{element_stiffness, Assembler, DofMap, Pattern, NO_SLOT};
 use crate::constraints::{internal_forces, Discretization, Reaction};
@@ -24,7 +24,10 @@ use crate::contact::{
 };
 use crate::model::Model;
 use crate::Error;
-use fibercell_solver::{solve_checked, LinearSolver, SolverError};
+use fibercell_solver::{
+    pcg_with_factor, relative_residual, solve_checked, AnalyzeInfo, LinearSolver, SolveInfo,
+    SolveReport, SolverError,
+};
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use serde::Serialize;
 
@@ -68,6 +71,12 @@ pub struct IncrementalOptions {
     /// evolve, with a Coulomb bound μ max(N, 0). A model of bonded or consolidated mats, whose
     /// just-touching contacts would otherwise open under the smallest strain and chatter.
     pub bonded: bool,
+    /// After a few contacts changed state (at most 1 % of them), solve by CG preconditioned with
+    /// the last symmetric factorization instead of refactorizing, within an iteration budget of
+    /// a tenth of a factorization's flops (refactorizing once the iterations spent on one
+    /// factorization add up to about its cost); fall back to a factorization when CG does not reach
+    /// a backward error 1000 times below the accepted one (default true).
+    pub reuse_factor: bool,
 }
 
 impl Default for IncrementalOptions {
@@ -81,6 +90,7 @@ impl Default for IncrementalOptions {
             progress: None,
             stabilization: 0.0,
             bonded: false,
+            reuse_factor: true,
         }
     }
 }
@@ -96,6 +106,10 @@ pub struct IncrementRecord {
     pub iterations: usize,
     /// Numeric factorizations done in this increment.
     pub factorizations: usize,
+    /// Solves done by CG preconditioned with an earlier factorization instead of a new one.
+    pub factor_reuses: usize,
+    /// CG iterations of those solves (and of attempts that fell back to a factorization).
+    pub reuse_iterations: usize,
     /// Contacts open, stuck and sliding at the end of the increment.
     pub open: usize,
     /// Stuck contacts.
@@ -324,6 +338,25 @@ fn stabilizer(pair: &ContactPair, state: ContactState) -> BlockMatrix {
     match state {
         ContactState::Open => pair.normal().0 + kt + pair.rotation(),
         _ => kt,
+    }
+}
+
+/// Contacts whose state, slip direction or k⊥ differ between two assembled keys.
+fn differing_contacts(a: &AssembledKey, b: &AssembledKey) -> usize {
+    (0..a.1.len())
+        .filter(|&i| a.1[i] != b.1[i] || a.2[i] != b.2[i] || a.3[i] != b.3[i])
+        .count()
+}
+
+/// CG iterations preconditioned by a factorization that cost at most a tenth of refactorizing:
+/// one iteration is two triangular solves (4 nnz(L) flops) and a product with A (2 nnz(A)).
+fn reuse_iterations(info: &AnalyzeInfo) -> usize {
+    match (info.flops, info.nnz_factor) {
+        (Some(flops), Some(nnz_l)) => {
+            let per_iteration = 4.0 * nnz_l as f64 + 2.0 * info.nnz_a as f64;
+            ((0.1 * flops / per_iteration) as usize).clamp(4, 500)
+        }
+        _ => 20,
     }
 }
 
@@ -599,8 +632,15 @@ pub(crate) fn run_incremental(
         )));
     }
     let mut dissipated = 0.0;
+    // CG iterations preconditioned by the previous factorization allowed per solve (0: none).
+    let mut reuse_budget = 0;
+    // CG iterations spent on the current factorization: once they add up to about one
+    // factorization, refactorize.
+    let mut spent_since_factor = 0;
     for (step, &alpha) in (1..).zip(&path) {
         let mut factorizations = 0;
+        let mut factor_reuses = 0;
+        let mut reuse_iterations_done = 0;
         let mut converged = None;
         // State switches per contact in this increment (chatter detection).
         let mut switches = vec![0usize; pairs.len()];
@@ -675,7 +715,10 @@ pub(crate) fn run_incremental(
             };
             if slot.is_none() {
                 let mut s = make_solver(kind, &opts.solve.ordering, disc.node_block_starts())?;
-                s.analyze(a).map_err(locate)?;
+                let info = s.analyze(a).map_err(locate)?;
+                if !nonsymmetric && !s.capabilities().iterative {
+                    reuse_budget = reuse_iterations(&info);
+                }
                 *slot = Some(s);
             }
             let solver = slot
@@ -687,16 +730,55 @@ pub(crate) fn run_incremental(
                 directions.clone(),
                 perpendicular.iter().map(|p| p.0).collect::<Vec<f64>>(),
             );
-            if factorized.as_ref() != Some(&key) {
-                solver.factorize(a).map_err(locate)?;
-                factorizations += 1;
-                factorized = Some(key);
+            // A symmetric factorization of nearby values preconditions CG on the new ones
+            // when few contacts changed since it was computed (each change is a low-rank
+            // update); otherwise, or when CG does not converge within its budget, refactorize.
+            let mut reused = None;
+            if let Some(old) = factorized.as_ref().filter(|_| n_free > 0) {
+                let differing = differing_contacts(old, &key);
+                if opts.reuse_factor
+                    && !nonsymmetric
+                    && !old.0
+                    && reuse_budget > 0
+                    && differing > 0
+                    && differing <= (pairs.len() / 100).max(1)
+                    && spent_since_factor < 10 * reuse_budget
+                {
+                    let tol = 1e-3 * backward_tolerance(&opts.solve);
+                    let r = pcg_with_factor(solver.as_mut(), a, &rhs, tol, reuse_budget)
+                        .map_err(locate)?;
+                    reuse_iterations_done += r.iterations;
+                    spent_since_factor += r.iterations.max(1);
+                    if r.converged {
+                        reused = Some(r);
+                    }
+                }
             }
-            let (x, report) = if n_free == 0 {
-                (Vec::new(), None)
+            let (x, report) = if let Some(r) = reused {
+                factor_reuses += 1;
+                let report = SolveReport {
+                    backend: "factor-pcg",
+                    relative_residual: relative_residual(a, &r.x, &rhs),
+                    backward_error: r.backward_error,
+                    info: SolveInfo {
+                        iterations: Some(r.iterations),
+                        ..SolveInfo::default()
+                    },
+                };
+                (r.x, Some(report))
             } else {
-                let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1).map_err(locate)?;
-                (x, Some(r))
+                if factorized.as_ref() != Some(&key) {
+                    solver.factorize(a).map_err(locate)?;
+                    factorizations += 1;
+                    factorized = Some(key);
+                    spent_since_factor = 0;
+                }
+                if n_free == 0 {
+                    (Vec::new(), None)
+                } else {
+                    let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1).map_err(locate)?;
+                    (x, Some(r))
+                }
             };
             let bwd = report.as_ref().map_or(0.0, |r| r.backward_error);
             check_backward_error(&opts.solve, bwd, &format!("increment {step}"))?;
@@ -847,6 +929,8 @@ pub(crate) fn run_incremental(
             reaction,
             macro_reaction,
             dissipated,
+            factor_reuses,
+            reuse_iterations: reuse_iterations_done,
             held: switches.iter().filter(|&&n| n >= CHATTER_SWITCHES).count(),
             backend: backend.to_string(),
             backward_error: bwd,

@@ -101,16 +101,21 @@ pub(crate) fn locate(
 }
 
 /// Rejects a solve whose backward error exceeds `options.max_backward_error` (1e-10 when 0).
+/// The accepted backward error of `options` (1e-10 when unset).
+pub(crate) fn backward_tolerance(options: &SolveOptions) -> f64 {
+    if options.max_backward_error > 0.0 {
+        options.max_backward_error
+    } else {
+        1e-10
+    }
+}
+
 pub(crate) fn check_backward_error(
     options: &SolveOptions,
     backward_error: f64,
     context: &str,
 ) -> Result<(), Error> {
-    let tol = if options.max_backward_error > 0.0 {
-        options.max_backward_error
-    } else {
-        1e-10
-    };
+    let tol = backward_tolerance(options);
     if backward_error <= tol {
         return Ok(());
     }

@@ -18,6 +18,7 @@
 
 mod csc;
 mod error;
+mod factor_pcg;
 mod lower;
 mod ordering;
 mod residual;
@@ -25,6 +26,7 @@ mod solver;
 
 pub use csc::{CscMatrix, CscRef, PatternFingerprint};
 pub use error::{SolverError, StopReason};
+pub use factor_pcg::{pcg_with_factor, FactorPcg};
 pub use lower::LowerTriangle;
 pub use ordering::{compute_ordering, Ordering, Permutation};
 pub use residual::{backward_error, relative_residual, solve_checked, SolveReport};
