@@ -20,6 +20,7 @@
 //! Units are SI throughout (m, N, Pa, rad). DOFs per node: ux, uy, uz, rx, ry, rz.
 
 pub mod assembly;
+pub mod bench;
 pub mod cell;
 pub mod constraints;
 pub mod contact;

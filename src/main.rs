@@ -109,6 +109,28 @@ enum Command {
         /// Output file (.toml, .json, .inp, .vtu or .pvd).
         output: PathBuf,
     },
+    /// Throughput benchmark on generated non-woven cells: every stage timed, against the
+    /// machine's measured DGEMM and memory bandwidth (see the README's performance section).
+    Bench {
+        /// Presets to run, comma-separated: S, M, L.
+        #[arg(long, default_value = "S,M", value_delimiter = ',')]
+        cells: Vec<String>,
+        /// Write the full report as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Write the Markdown tables here too.
+        #[arg(long)]
+        markdown: Option<PathBuf>,
+        /// Repeats of each stage (medians are reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Generator seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Increments of the elasto-plastic curve (0: skip it).
+        #[arg(long, default_value_t = 100)]
+        curve_steps: usize,
+    },
     /// Write the reduced stiffness matrix in Matrix Market form (symmetric, lower triangle).
     ExportMatrix {
         /// Model file.
@@ -338,6 +360,25 @@ fn parse_ordering(s: &str) -> Result<Ordering, String> {
             "unknown ordering \"{s}\" (use auto, amd, nd or natural)"
         )),
     }
+}
+
+fn bench(
+    opts: fibercell::bench::BenchOptions,
+    json: Option<&Path>,
+    markdown: Option<&Path>,
+) -> Result<(), Error> {
+    let report = fibercell::bench::run_bench(&opts, &mut |what| eprintln!("bench: {what}"))?;
+    let text = fibercell::bench::markdown(&report);
+    println!("{text}");
+    if let Some(p) = json {
+        let doc = serde_json::to_string_pretty(&report)
+            .map_err(|e| Error::InvalidOption(format!("cannot serialize the report: {e}")))?;
+        write(p, &doc)?;
+    }
+    if let Some(p) = markdown {
+        write(p, &text)?;
+    }
+    Ok(())
 }
 
 fn write(path: &Path, contents: &str) -> Result<(), Error> {
@@ -941,6 +982,24 @@ fn main() -> ExitCode {
         Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),
         Command::Convert { input, output } => convert(&input, &output),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
+        Command::Bench {
+            cells,
+            json,
+            markdown,
+            repeats,
+            seed,
+            curve_steps,
+        } => bench(
+            fibercell::bench::BenchOptions {
+                cells,
+                seed,
+                repeats,
+                curve_steps,
+                ..Default::default()
+            },
+            json.as_deref(),
+            markdown.as_deref(),
+        ),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

@@ -15,4 +15,4 @@ pub use elastic::{homogenize_elastic, HomogenizeTimings, Homogenized, PressureRe
 pub use orthotropic::{Orthotropic, ThesisModuli};
 pub use pressure::{default_pixel, pressure_load, PressureLoad};
 pub use segments::{segment_starting_at, Segment};
-pub use system::PeriodicSystem;
+pub use system::{ContactStiffness, PeriodicSystem, PeriodicValues, SetupTimings};

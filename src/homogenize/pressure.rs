@@ -14,6 +14,10 @@ use crate::cell::CellGeometry;
 use crate::contact::centerline_interpolation;
 use crate::model::Model;
 use nalgebra::{SMatrix, Vector3};
+use rayon::prelude::*;
+
+/// A consistent load on an element image: ((element, period shift), 12-vector).
+type ImageLoad = ((usize, [i32; 2]), SMatrix<f64, 12, 1>);
 
 /// At most this many pixels (the pixel grows beyond it).
 const MAX_PIXELS: usize = 4_000_000;
@@ -52,7 +56,10 @@ pub fn pressure_load(model: &Model, g: &CellGeometry, p: f64, pixel: f64) -> Pre
     }
     let (nx, ny) = ((lx / h).ceil() as usize, (ly / h).ceil() as usize);
     let (hx, hy) = (lx / nx as f64, ly / ny as f64);
-    // Element images whose xy box (grown by the radius) reaches the cell, bucketed on a grid.
+    let interpolation = |e: usize, t: f64| {
+        let [a, b] = els[e].nodes.map(|n| model.nodes[n].x);
+        centerline_interpolation(&a, &b, t)
+    };
     let radius = |e: usize| model.fibers[els[e].fiber].section.radius;
     let ends = |e: usize, s: [i32; 2]| {
         els[e].nodes.map(|n| {
@@ -64,19 +71,8 @@ pub fn pressure_load(model: &Model, g: &CellGeometry, p: f64, pixel: f64) -> Pre
             )
         })
     };
-    let bucket = els
-        .iter()
-        .enumerate()
-        .map(|(e, el)| {
-            let [a, b] = el.nodes.map(|n| model.nodes[n].x);
-            ((a[0] - b[0]).abs().max((a[1] - b[1]).abs()) + 2.0 * radius(e)).min(lx.max(ly))
-        })
-        .fold(h, f64::max);
-    let (bx, by) = (
-        ((lx / bucket).floor() as usize).max(1),
-        ((ly / bucket).floor() as usize).max(1),
-    );
-    let mut buckets: Vec<Vec<(usize, [i32; 2])>> = vec![Vec::new(); bx * by];
+    // Every element image (element, shift) that reaches into the cell, with its pixel rows.
+    let mut images: Vec<(usize, [i32; 2], usize, usize)> = Vec::new();
     for e in 0..els.len() {
         let r = radius(e);
         for i in -1..=1 {
@@ -93,63 +89,86 @@ pub fn pressure_load(model: &Model, g: &CellGeometry, p: f64, pixel: f64) -> Pre
                 if hi[0] < 0.0 || hi[1] < 0.0 || lo[0] > lx || lo[1] > ly {
                     continue;
                 }
-                let cell = |v: f64, len: f64, n: usize| {
-                    ((v / len * n as f64).floor().max(0.0) as usize).min(n - 1)
-                };
-                for u in cell(lo[0], lx, bx)..=cell(hi[0], lx, bx) {
-                    for v in cell(lo[1], ly, by)..=cell(hi[1], ly, by) {
-                        buckets[v * bx + u].push((e, [i, j]));
+                let row = |y: f64| ((y / hy - 0.5).floor().max(0.0) as usize).min(ny - 1);
+                images.push((e, [i, j], row(lo[1]), (row(hi[1]) + 1).min(ny - 1)));
+            }
+        }
+    }
+    // Rasterize band by band (in parallel): per pixel the highest fiber surface over its centre,
+    // ties to the first image in (element, shift) order; then the pixel's force on that image.
+    const BAND: usize = 128;
+    let pixel_force = p * hx * hy;
+    let bands: Vec<(usize, Vec<ImageLoad>)> = (0..ny.div_ceil(BAND))
+        .into_par_iter()
+        .map(|band| {
+            let v0 = band * BAND;
+            let v1 = (v0 + BAND).min(ny);
+            let mut top = vec![f64::NEG_INFINITY; (v1 - v0) * nx];
+            let mut hit: Vec<(u32, f64)> = vec![(u32::MAX, 0.0); (v1 - v0) * nx];
+            for (k, &(e, s, r0, r1)) in images.iter().enumerate() {
+                if r1 < v0 || r0 >= v1 {
+                    continue;
+                }
+                let [a, b] = ends(e, s);
+                let r = radius(e);
+                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+                let len2 = dx * dx + dy * dy;
+                let x_lo = a[0].min(b[0]) - r - g.origin[0];
+                let x_hi = a[0].max(b[0]) + r - g.origin[0];
+                let u0 = ((x_lo / hx - 0.5).floor().max(0.0) as usize).min(nx - 1);
+                let u1 = ((x_hi / hx - 0.5).ceil().max(0.0) as usize).min(nx - 1);
+                for v in r0.max(v0)..=r1.min(v1 - 1) {
+                    let py = g.origin[1] + (v as f64 + 0.5) * hy;
+                    for u in u0..=u1 {
+                        let px = g.origin[0] + (u as f64 + 0.5) * hx;
+                        let t = if len2 > 0.0 {
+                            (((px - a[0]) * dx + (py - a[1]) * dy) / len2).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        let (cx, cy) = (a[0] + t * dx, a[1] + t * dy);
+                        let d2 = (px - cx).powi(2) + (py - cy).powi(2);
+                        if d2 > r * r {
+                            continue;
+                        }
+                        let z = a[2] + t * (b[2] - a[2]) + (r * r - d2).sqrt();
+                        let idx = (v - v0) * nx + u;
+                        if z > top[idx] {
+                            top[idx] = z;
+                            hit[idx] = (k as u32, t);
+                        }
                     }
                 }
             }
-        }
-    }
-    // The highest surface over every pixel centre.
-    let mut hits: Vec<(usize, [i32; 2], f64)> = Vec::new();
-    for v in 0..ny {
-        for u in 0..nx {
-            let px = g.origin[0] + (u as f64 + 0.5) * hx;
-            let py = g.origin[1] + (v as f64 + 0.5) * hy;
-            let bu = ((u as f64 + 0.5) * hx / lx * bx as f64) as usize;
-            let bv = ((v as f64 + 0.5) * hy / ly * by as f64) as usize;
-            let mut best: Option<(f64, usize, [i32; 2], f64)> = None;
-            for &(e, s) in &buckets[bv.min(by - 1) * bx + bu.min(bx - 1)] {
-                let [a, b] = ends(e, s);
-                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-                let len2 = dx * dx + dy * dy;
-                let t = if len2 > 0.0 {
-                    (((px - a[0]) * dx + (py - a[1]) * dy) / len2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let (cx, cy) = (a[0] + t * dx, a[1] + t * dy);
-                let d2 = (px - cx).powi(2) + (py - cy).powi(2);
-                let r = radius(e);
-                if d2 > r * r {
+            let mut count = 0;
+            let mut loads: Vec<ImageLoad> = Vec::new();
+            for &(k, t) in &hit {
+                if k == u32::MAX {
                     continue;
                 }
-                let top = a[2] + t * (b[2] - a[2]) + (r * r - d2).sqrt();
-                if best.is_none_or(|(z, ..)| top > z) {
-                    best = Some((top, e, s, t));
+                count += 1;
+                let (e, s, ..) = images[k as usize];
+                let f = interpolation(e, t).transpose() * Vector3::new(0.0, 0.0, -pixel_force);
+                loads.push(((e, s), f));
+            }
+            loads.sort_by_key(|&(key, _)| key);
+            let mut merged: Vec<ImageLoad> = Vec::new();
+            for (key, f) in loads {
+                match merged.last_mut() {
+                    Some(last) if last.0 == key => last.1 += f,
+                    _ => merged.push((key, f)),
                 }
             }
-            if let Some((_, e, s, t)) = best {
-                hits.push((e, s, t));
-            }
-        }
-    }
-    let pixel_force = p * hx * hy;
-    let force = pixel_force * hits.len() as f64;
-    let coverage = hits.len() as f64 / (nx * ny) as f64;
-    let mut loads: Vec<(usize, [i32; 2], SMatrix<f64, 12, 1>)> = Vec::new();
-    let interpolation = |e: usize, t: f64| {
-        let [a, b] = els[e].nodes.map(|n| model.nodes[n].x);
-        centerline_interpolation(&a, &b, t)
-    };
-    for (e, s, t) in hits {
-        let f = interpolation(e, t).transpose() * Vector3::new(0.0, 0.0, -pixel_force);
-        loads.push((e, s, f));
-    }
+            (count, merged)
+        })
+        .collect();
+    let hits: usize = bands.iter().map(|b| b.0).sum();
+    let force = pixel_force * hits as f64;
+    let coverage = hits as f64 / (nx * ny) as f64;
+    let mut loads: Vec<(usize, [i32; 2], SMatrix<f64, 12, 1>)> = bands
+        .into_iter()
+        .flat_map(|(_, l)| l.into_iter().map(|((e, s), f)| (e, s, f)))
+        .collect();
     // The balancing body force: per unit fiber volume, integrated with 3-point Gauss (exact for
     // the cubic shape functions).
     let volumes: Vec<f64> = els

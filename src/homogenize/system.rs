@@ -25,6 +25,26 @@ pub struct PeriodicValues {
     pub k_ee: SMatrix<f64, 6, 6>,
 }
 
+/// The tangential state a closed contact enters the cell matrix with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactStiffness {
+    /// K_N + K_T^st + K_R (the elastic moduli A^elas).
+    Stick,
+    /// K_N + K_R: no tangential stiffness (a contact sliding under a Tresca bound).
+    Sliding,
+}
+
+/// Wall-clock seconds of [`PeriodicSystem::new`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct SetupTimings {
+    /// Boundary pairing, contact search with the periodic images, percolation check.
+    pub contacts: f64,
+    /// Numbering and element/contact blocks on generalized nodes.
+    pub blocks: f64,
+    /// The sparsity pattern with its slot maps.
+    pub pattern: f64,
+}
+
 /// Numbering, pattern and block maps of a periodic cell.
 #[derive(Clone, Debug)]
 pub struct PeriodicSystem {
@@ -38,6 +58,8 @@ pub struct PeriodicSystem {
     contacts: Vec<ContactPair>,
     /// The node whose translations are fixed.
     pub anchor: usize,
+    /// How long building it took.
+    pub timings: SetupTimings,
 }
 
 /// Node pairs joined by the contact pairs `which` (for connectivity checks), with the period
@@ -87,7 +109,13 @@ impl PeriodicSystem {
     /// Pairs the boundary, finds the contacts, checks percolation, numbers the unknowns and
     /// builds the pattern.
     pub fn new(model: &Model) -> Result<Self, Error> {
+        let clock = std::time::Instant::now();
         let (periodicity, set, anchor) = prepare_cell(model, true)?;
+        let mut timings = SetupTimings {
+            contacts: clock.elapsed().as_secs_f64(),
+            ..SetupTimings::default()
+        };
+        let clock = std::time::Instant::now();
         let closed: Vec<usize> = (0..set.pairs.len())
             .filter(|&i| set.pairs[i].gap <= 0.0)
             .collect();
@@ -106,12 +134,15 @@ impl PeriodicSystem {
             .map(|(g, _)| &g[..])
             .chain(contacts.iter().map(|c| &c.jump.nodes[..]))
             .collect();
+        timings.blocks = clock.elapsed().as_secs_f64();
+        let clock = std::time::Instant::now();
         let pattern = Pattern::from_blocks(
             discretization.reduced_indices(),
             discretization.n_free(),
             &blocks,
             elements.len(),
         )?;
+        timings.pattern = clock.elapsed().as_secs_f64();
         Ok(PeriodicSystem {
             periodicity,
             discretization,
@@ -119,6 +150,7 @@ impl PeriodicSystem {
             elements,
             contacts,
             anchor,
+            timings,
         })
     }
 
@@ -139,56 +171,84 @@ impl PeriodicSystem {
 
     /// Assembles K_ff, K_fE and K_EE (elements and closed contacts in stick).
     pub fn assemble(&self, model: &Model) -> PeriodicValues {
-        let disc = &self.discretization;
-        let driver = disc.driver().unwrap_or(usize::MAX);
-        let mut out = PeriodicValues {
+        let mut out = self.zero_values();
+        self.add_elements(model, &mut out);
+        self.add_contacts(&mut out, |_| ContactStiffness::Stick);
+        out
+    }
+
+    /// All values zero.
+    pub fn zero_values(&self) -> PeriodicValues {
+        PeriodicValues {
             values: vec![0.0; self.pattern.nnz()],
-            coupling: vec![[0.0; 6]; disc.n_free()],
+            coupling: vec![[0.0; 6]; self.discretization.n_free()],
             k_ee: SMatrix::zeros(),
-        };
-        let mut scatter = |gnodes: &[usize], k: &DMatrix<f64>, slots: &[u32]| {
-            let m = 6 * gnodes.len();
-            let gdof = |r: usize| 6 * gnodes[r / 6] + r % 6;
-            for r in 0..m {
-                let driver_r = gnodes[r / 6] == driver;
-                for c in 0..m {
-                    let v = k[(r, c)];
-                    let driver_c = gnodes[c / 6] == driver;
-                    match (driver_r, driver_c) {
-                        (true, true) => out.k_ee[(r % 6, c % 6)] += v,
-                        (false, true) => {
-                            if let Some(i) = disc.reduced(gdof(r)) {
-                                out.coupling[i][c % 6] += v;
-                            }
-                        }
-                        (_, false) => {
-                            let s = slots[r * m + c];
-                            if s != NO_SLOT {
-                                out.values[s as usize] += v;
-                            }
-                        }
-                    }
-                }
-            }
-        };
+        }
+    }
+
+    /// Adds Tᵀ K T of every element.
+    pub fn add_elements(&self, model: &Model, out: &mut PeriodicValues) {
         for (e, (gnodes, t)) in self.elements.iter().enumerate() {
             let k = element_stiffness(model, e);
             let k = DMatrix::from_fn(12, 12, |r, c| k[(r, c)]);
-            scatter(
+            self.scatter(
+                out,
                 gnodes,
                 &(t.transpose() * k * t),
                 self.pattern.element_slots(e),
             );
         }
+    }
+
+    /// Adds the closed contacts, contact i with the stiffness `which(i)`.
+    pub fn add_contacts(
+        &self,
+        out: &mut PeriodicValues,
+        which: impl Fn(usize) -> ContactStiffness,
+    ) {
         for (i, pair) in self.contacts.iter().enumerate() {
             let m = pair.size();
             let (kn, _) = pair.normal();
-            let (kt, _) = pair.stick(&Vector2::zeros());
             let kr = pair.rotation();
-            let k = DMatrix::from_fn(m, m, |r, c| kn[(r, c)] + kt[(r, c)] + kr[(r, c)]);
-            scatter(&pair.jump.nodes, &k, self.pattern.extra_slots(i));
+            let k = match which(i) {
+                ContactStiffness::Stick => {
+                    let (kt, _) = pair.stick(&Vector2::zeros());
+                    kn + kt + kr
+                }
+                ContactStiffness::Sliding => kn + kr,
+            };
+            let k = DMatrix::from_fn(m, m, |r, c| k[(r, c)]);
+            self.scatter(out, &pair.jump.nodes, &k, self.pattern.extra_slots(i));
         }
-        out
+    }
+
+    /// Adds the block `k` on generalized nodes `gnodes` through its pattern `slots`.
+    fn scatter(&self, out: &mut PeriodicValues, gnodes: &[usize], k: &DMatrix<f64>, slots: &[u32]) {
+        let disc = &self.discretization;
+        let driver = disc.driver().unwrap_or(usize::MAX);
+        let m = 6 * gnodes.len();
+        let gdof = |r: usize| 6 * gnodes[r / 6] + r % 6;
+        for r in 0..m {
+            let driver_r = gnodes[r / 6] == driver;
+            for c in 0..m {
+                let v = k[(r, c)];
+                let driver_c = gnodes[c / 6] == driver;
+                match (driver_r, driver_c) {
+                    (true, true) => out.k_ee[(r % 6, c % 6)] += v,
+                    (false, true) => {
+                        if let Some(i) = disc.reduced(gdof(r)) {
+                            out.coupling[i][c % 6] += v;
+                        }
+                    }
+                    (_, false) => {
+                        let s = slots[r * m + c];
+                        if s != NO_SLOT {
+                            out.values[s as usize] += v;
+                        }
+                    }
+                }
+            }
+        }
     }
 
     /// Nodal displacements and rotations of every node for the unknowns `x` and the drivers `e`.

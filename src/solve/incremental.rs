@@ -132,6 +132,9 @@ pub struct IncrementRecord {
     pub held: usize,
     /// Backend of the last solve.
     pub backend: String,
+    /// Wall-clock seconds of the increment (not serialized: results files stay reproducible).
+    #[serde(skip)]
+    pub seconds: f64,
     /// Backward error of the last solve.
     pub backward_error: f64,
 }
@@ -638,6 +641,7 @@ pub(crate) fn run_incremental(
     // factorization, refactorize.
     let mut spent_since_factor = 0;
     for (step, &alpha) in (1..).zip(&path) {
+        let increment_start = std::time::Instant::now();
         let mut factorizations = 0;
         let mut factor_reuses = 0;
         let mut reuse_iterations_done = 0;
@@ -933,6 +937,7 @@ pub(crate) fn run_incremental(
             reuse_iterations: reuse_iterations_done,
             held: switches.iter().filter(|&&n| n >= CHATTER_SWITCHES).count(),
             backend: backend.to_string(),
+            seconds: increment_start.elapsed().as_secs_f64(),
             backward_error: bwd,
         });
         out.contact_results.push(records);

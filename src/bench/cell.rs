@@ -1,0 +1,433 @@
+//! The stages of one benchmark cell: generation, contact search, pattern, value fill, every
+//! applicable backend's symbolic analysis, numeric factorization and solve, the solve after a
+//! few contact switches with the previous factor as preconditioner, the six elastic cell
+//! problems and an elasto-plastic curve.
+
+use super::machine::peak_memory_bytes;
+use super::BenchOptions;
+use crate::cell::pair_boundary_nodes;
+use crate::contact::{find_candidates, ContactSet};
+use crate::generate::{nonwoven, nonwoven_preset};
+use crate::homogenize::{
+    elasto_plastic_curve, homogenize_elastic, ContactStiffness, CurveOptions, PeriodicSystem,
+};
+use crate::model::{FrictionSpec, Model};
+use crate::solve::{make_solver, IncrementalOptions, SolveOptions, SolverKind};
+use crate::Error;
+use fibercell_solver::{pcg_with_factor, CscRef, Ordering};
+use serde::Serialize;
+use std::time::Instant;
+
+/// Median of `repeats` timings of `f` (seconds), with the last result.
+fn median_of<T>(
+    repeats: usize,
+    mut f: impl FnMut() -> Result<T, Error>,
+) -> Result<(f64, T), Error> {
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let t = Instant::now();
+        last = Some(f()?);
+        times.push(t.elapsed().as_secs_f64());
+    }
+    times.sort_by(f64::total_cmp);
+    let out = last.ok_or_else(|| Error::InvalidOption("no repeat ran".into()))?;
+    Ok((times[times.len() / 2], out))
+}
+
+/// One backend on the cell-problem matrix.
+#[derive(Clone, Debug, Serialize)]
+pub struct BackendBench {
+    /// Backend and requested ordering, e.g. "faer-cholesky/auto".
+    pub name: String,
+    /// The ordering the backend reports it used.
+    pub ordering: String,
+    /// Symbolic analysis (s).
+    pub analyze: f64,
+    /// Numeric factorization, median (s).
+    pub factorize: f64,
+    /// One solve with one right-hand side, median (s).
+    pub solve: f64,
+    /// Entries of L.
+    pub nnz_l: Option<usize>,
+    /// Flops of one factorization, as the backend counts them.
+    pub flops: Option<f64>,
+    /// Factorization GFLOP/s.
+    pub gflops: Option<f64>,
+    /// Factorization GFLOP/s as a fraction of the all-thread DGEMM peak.
+    pub fraction_of_dgemm: Option<f64>,
+    /// Bytes of L read twice (forward and backward) per second in the solve, as a fraction of
+    /// the triad bandwidth.
+    pub solve_fraction_of_bandwidth: Option<f64>,
+}
+
+/// The solve after k contacts switched stick → sliding, by CG preconditioned with the factor of
+/// the unswitched matrix, against a refactorization.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReuseBench {
+    /// Contacts switched.
+    pub switched: usize,
+    /// As a fraction of the closed contacts.
+    pub fraction: f64,
+    /// CG iterations to a backward error of 1e-13.
+    pub iterations: usize,
+    /// Whether it got there within 500 iterations.
+    pub converged: bool,
+    /// Seconds of the preconditioned CG solve.
+    pub seconds: f64,
+    /// Its cost relative to a numeric factorization plus solve.
+    pub ratio_to_refactorization: f64,
+}
+
+/// The incremental elasto-plastic curve.
+#[derive(Clone, Debug, Serialize)]
+pub struct CurveBench {
+    /// Increments.
+    pub steps: usize,
+    /// Macroscopic strain ε11 at the end.
+    pub strain: f64,
+    /// Tresca bound of the contacts (N).
+    pub tresca_bound: f64,
+    /// Whole curve including its all-stick elastic homogenization (s).
+    pub total: f64,
+    /// Median increment (s).
+    pub increment_median: f64,
+    /// Slowest increment (s).
+    pub increment_max: f64,
+    /// State iterations in all.
+    pub state_iterations: usize,
+    /// Numeric factorizations in all.
+    pub factorizations: usize,
+    /// Solves by CG on an earlier factor.
+    pub factor_reuses: usize,
+    /// Contacts sliding at the end.
+    pub sliding_at_end: usize,
+    /// Contacts held after chattering (summed over increments).
+    pub held: usize,
+    /// The error, when the curve failed.
+    pub error: Option<String>,
+}
+
+/// Every stage of one cell.
+#[derive(Clone, Debug, Serialize)]
+pub struct CellBench {
+    /// S, M or L.
+    pub cell: String,
+    /// Fibers deposited.
+    pub fibers: usize,
+    /// Elements (= segments searched).
+    pub elements: usize,
+    /// Closed contacts entering the cell problems.
+    pub contacts: usize,
+    /// Free DOFs of the cell problem.
+    pub dofs: usize,
+    /// Stored entries of K (both triangles).
+    pub nnz_k: usize,
+    /// Generation (s).
+    pub generation: f64,
+    /// Broad and narrow phase of the contact search with periodic images (s).
+    pub contact_search: f64,
+    /// Segments searched per second.
+    pub segments_per_second: f64,
+    /// The whole contact set: search, merge, kinematics, penalties (s).
+    pub contact_set: f64,
+    /// Pairing, contacts and percolation check of the cell system (s).
+    pub setup: f64,
+    /// The sparsity pattern and slot maps (s).
+    pub pattern: f64,
+    /// Value fill of the elements, median (s).
+    pub fill_elements: f64,
+    /// Elements filled per second.
+    pub elements_per_second: f64,
+    /// Value fill of the closed contacts, median (s).
+    pub fill_contacts: f64,
+    /// Contact pairs filled per second.
+    pub pairs_per_second: f64,
+    /// Fill bytes written (values, 8 per scattered entry) per second as a fraction of the
+    /// triad bandwidth.
+    pub fill_fraction_of_bandwidth: f64,
+    /// Each applicable backend.
+    pub backends: Vec<BackendBench>,
+    /// Solves after contact switches without refactorizing.
+    pub reuse: Vec<ReuseBench>,
+    /// The six elastic cell problems (and Θ) end to end, median (s).
+    pub six_cell_problems: f64,
+    /// Their stages (of the median run).
+    pub six_cell_problem_stages: crate::homogenize::HomogenizeTimings,
+    /// The elasto-plastic curve (None when skipped).
+    pub curve: Option<CurveBench>,
+    /// Peak resident memory of the process after this cell (bytes).
+    pub peak_memory: Option<u64>,
+}
+
+/// The backends that apply: faer Cholesky with each ordering, CHOLMOD (with the feature) with
+/// its default and with the same nested dissection as faer. Block-Jacobi CG needs tens of
+/// thousands of iterations on slender-fiber systems: it enters as the factor-preconditioned
+/// solve after contact switches instead ([`ReuseBench`]).
+fn backends() -> Vec<(String, SolverKind, Ordering)> {
+    let mut v = vec![
+        (
+            "faer-cholesky/auto".to_string(),
+            SolverKind::FaerCholesky,
+            Ordering::Auto,
+        ),
+        (
+            "faer-cholesky/amd".into(),
+            SolverKind::FaerCholesky,
+            Ordering::Amd,
+        ),
+        (
+            "faer-cholesky/nd".into(),
+            SolverKind::FaerCholesky,
+            Ordering::NestedDissection,
+        ),
+    ];
+    if cfg!(feature = "cholmod") {
+        v.push((
+            "cholmod/default".into(),
+            SolverKind::Cholmod,
+            Ordering::Auto,
+        ));
+        v.push((
+            "cholmod/nd".into(),
+            SolverKind::Cholmod,
+            Ordering::NestedDissection,
+        ));
+    }
+    v
+}
+
+fn bench_backend(
+    name: &str,
+    kind: SolverKind,
+    ordering: &Ordering,
+    a: CscRef<'_>,
+    rhs: &[f64],
+    repeats: usize,
+    machine: &super::Machine,
+) -> Result<BackendBench, Error> {
+    let mut solver = make_solver(kind, ordering, Vec::new())?;
+    let t = Instant::now();
+    let info = solver.analyze(a)?;
+    let analyze = t.elapsed().as_secs_f64();
+    let (factorize, _) = median_of(repeats, || Ok(solver.factorize(a)?))?;
+    let (solve, _) = median_of(repeats, || {
+        let mut x = rhs.to_vec();
+        Ok(solver.solve_in_place(&mut x, 1)?)
+    })?;
+    let direct = !solver.capabilities().iterative;
+    let gflops = info.flops.filter(|_| direct).map(|f| f / factorize / 1e9);
+    Ok(BackendBench {
+        name: name.to_string(),
+        ordering: info.ordering.clone(),
+        analyze,
+        factorize: if direct { factorize } else { 0.0 },
+        solve,
+        nnz_l: info.nnz_factor,
+        flops: info.flops,
+        gflops,
+        fraction_of_dgemm: gflops.map(|g| g / machine.dgemm_gflops_all),
+        solve_fraction_of_bandwidth: info
+            .nnz_factor
+            .filter(|_| direct)
+            .map(|l| 2.0 * 12.0 * l as f64 / solve / 1e9 / machine.bandwidth_gbs),
+    })
+}
+
+/// Solves after switching k contacts, for k at the given fractions of the contacts.
+fn bench_reuse(
+    sys: &PeriodicSystem,
+    model: &Model,
+    rhs: &[f64],
+    fractions: &[f64],
+) -> Result<Vec<ReuseBench>, Error> {
+    let base = sys.assemble(model);
+    let a0 = sys.pattern.matrix(&base.values)?;
+    let mut factor = make_solver(SolverKind::FaerCholesky, &Ordering::Auto, Vec::new())?;
+    factor.analyze(a0)?;
+    let t = Instant::now();
+    factor.factorize(a0)?;
+    let mut x = rhs.to_vec();
+    factor.solve_in_place(&mut x, 1)?;
+    let refactor = t.elapsed().as_secs_f64();
+    let n_contacts = sys.n_contacts();
+    let mut out = Vec::new();
+    for &fraction in fractions {
+        let k = ((fraction * n_contacts as f64).round() as usize).max(1);
+        // Every (n/k)-th contact slides: spread over the cell.
+        let stride = (n_contacts / k).max(1);
+        let mut values = sys.zero_values();
+        sys.add_elements(model, &mut values);
+        sys.add_contacts(&mut values, |i| {
+            if i % stride == 0 && i / stride < k {
+                ContactStiffness::Sliding
+            } else {
+                ContactStiffness::Stick
+            }
+        });
+        let a = sys.pattern.matrix(&values.values)?;
+        let t = Instant::now();
+        let r = pcg_with_factor(factor.as_mut(), a, rhs, 1e-13, 500)?;
+        let seconds = t.elapsed().as_secs_f64();
+        out.push(ReuseBench {
+            switched: k,
+            fraction: k as f64 / n_contacts.max(1) as f64,
+            iterations: r.iterations,
+            converged: r.converged,
+            seconds,
+            ratio_to_refactorization: seconds / refactor,
+        });
+    }
+    Ok(out)
+}
+
+fn bench_curve(
+    model_desc: &crate::model::ModelDescription,
+    opts: &BenchOptions,
+) -> Result<CurveBench, Error> {
+    let mut desc = model_desc.clone();
+    if let Some(c) = desc.contact.as_mut() {
+        c.friction = FrictionSpec::Tresca {
+            bound: opts.tresca_bound,
+        };
+    }
+    let model = Model::from_description(&desc)?;
+    let curve_opts = CurveOptions {
+        strain: [opts.curve_strain, 0.0, 0.0, 0.0, 0.0, 0.0],
+        steps: opts.curve_steps,
+        unload: false,
+        incremental: IncrementalOptions {
+            bonded: true,
+            stabilization: 1e-8,
+            ..IncrementalOptions::default()
+        },
+    };
+    let t = Instant::now();
+    let result = elasto_plastic_curve(&model, &curve_opts);
+    let total = t.elapsed().as_secs_f64();
+    let mut bench = CurveBench {
+        steps: opts.curve_steps,
+        strain: opts.curve_strain,
+        tresca_bound: opts.tresca_bound,
+        total,
+        increment_median: 0.0,
+        increment_max: 0.0,
+        state_iterations: 0,
+        factorizations: 0,
+        factor_reuses: 0,
+        sliding_at_end: 0,
+        held: 0,
+        error: None,
+    };
+    match result {
+        Ok(c) => {
+            let inc = &c.solution.increments;
+            let mut secs: Vec<f64> = inc.iter().map(|r| r.seconds).collect();
+            secs.sort_by(f64::total_cmp);
+            bench.increment_median = secs.get(secs.len() / 2).copied().unwrap_or(0.0);
+            bench.increment_max = secs.last().copied().unwrap_or(0.0);
+            bench.state_iterations = inc.iter().map(|r| r.iterations).sum();
+            bench.factorizations = inc.iter().map(|r| r.factorizations).sum();
+            bench.factor_reuses = inc.iter().map(|r| r.factor_reuses).sum();
+            bench.held = inc.iter().map(|r| r.held).sum();
+            bench.sliding_at_end = inc.last().map_or(0, |r| r.slip);
+        }
+        Err(e) => bench.error = Some(e.to_string()),
+    }
+    Ok(bench)
+}
+
+/// Runs every stage on the preset `cell`.
+pub fn bench_cell(
+    cell: &str,
+    opts: &BenchOptions,
+    machine: &super::Machine,
+    log: &mut dyn FnMut(&str),
+) -> Result<CellBench, Error> {
+    let params = nonwoven_preset(cell, opts.seed)?;
+    log(&format!("{cell}: generating"));
+    let (generation, generated) = median_of(1, || nonwoven(&params))?;
+    let model = Model::from_description(&generated.description)?;
+    let periodicity = pair_boundary_nodes(&model)?;
+    let tolerance = model.contact.as_ref().map_or(0.0, |c| c.tolerance);
+    log(&format!("{cell}: contact search"));
+    let (contact_search, _) = median_of(opts.repeats, || {
+        Ok(find_candidates(&model, tolerance, Some(&periodicity)))
+    })?;
+    let (contact_set, _) = median_of(opts.repeats, || {
+        Ok(ContactSet::build_with(&model, Some(&periodicity))?)
+    })?;
+    log(&format!("{cell}: pattern and fill"));
+    let sys = PeriodicSystem::new(&model)?;
+    let elements = model.elements().len();
+    let (fill_elements, _) = median_of(opts.repeats, || {
+        let mut v = sys.zero_values();
+        sys.add_elements(&model, &mut v);
+        Ok(v)
+    })?;
+    let (fill_contacts, _) = median_of(opts.repeats, || {
+        let mut v = sys.zero_values();
+        sys.add_contacts(&mut v, |_| ContactStiffness::Stick);
+        Ok(v)
+    })?;
+    let values = sys.assemble(&model);
+    let a = sys.pattern.matrix(&values.values)?;
+    let n = sys.n_free();
+    // The first cell problem's right-hand side, −K_fE e₁.
+    let rhs: Vec<f64> = values.coupling.iter().map(|c| -c[0]).collect();
+    let scattered = 144.0 * elements as f64 + 576.0 * sys.n_contacts() as f64;
+    let fill_bytes = 8.0 * scattered;
+    let mut backend_results = Vec::new();
+    for (name, kind, ordering) in backends() {
+        log(&format!("{cell}: {name}"));
+        backend_results.push(bench_backend(
+            &name,
+            kind,
+            &ordering,
+            a,
+            &rhs,
+            opts.repeats,
+            machine,
+        )?);
+    }
+    log(&format!("{cell}: solves after contact switches"));
+    let reuse = bench_reuse(&sys, &model, &rhs, &[0.001, 0.003, 0.01, 0.03])?;
+    log(&format!("{cell}: six cell problems"));
+    let (six, homogenized) = median_of(opts.repeats, || {
+        homogenize_elastic(&model, &SolveOptions::default())
+    })?;
+    let curve = if opts.curve_steps > 0 {
+        log(&format!("{cell}: {}-increment curve", opts.curve_steps));
+        Some(bench_curve(&generated.description, opts)?)
+    } else {
+        None
+    };
+    Ok(CellBench {
+        cell: cell.to_string(),
+        fibers: generated.report.deposited,
+        elements,
+        contacts: sys.n_contacts(),
+        dofs: n,
+        nnz_k: a.nnz(),
+        generation,
+        contact_search,
+        segments_per_second: elements as f64 / contact_search,
+        contact_set,
+        setup: sys.timings.contacts,
+        pattern: sys.timings.pattern,
+        fill_elements,
+        elements_per_second: elements as f64 / fill_elements,
+        fill_contacts,
+        pairs_per_second: sys.n_contacts() as f64 / fill_contacts,
+        fill_fraction_of_bandwidth: fill_bytes
+            / (fill_elements + fill_contacts)
+            / 1e9
+            / machine.bandwidth_gbs,
+        backends: backend_results,
+        reuse,
+        six_cell_problems: six,
+        six_cell_problem_stages: homogenized.timings,
+        curve,
+        peak_memory: peak_memory_bytes(),
+    })
+}

@@ -1,0 +1,89 @@
+//! The throughput benchmark behind `fibercell bench`: generated non-woven cells S, M and L
+//! ([`crate::generate::nonwoven_preset`]), every stage timed separately (generation, contact
+//! search, pattern, value fill, symbolic analysis, numeric factorization and solve per backend,
+//! the solve after contact switches on the previous factor, the six elastic cell problems, an
+//! elasto-plastic curve), with nnz(K), nnz(L), flops and peak memory, and the machine's own
+//! limits (DGEMM, memory bandwidth) that each stage is reported against.
+
+mod cell;
+mod machine;
+mod report;
+
+pub use cell::{bench_cell, BackendBench, CellBench, CurveBench, ReuseBench};
+pub use machine::{dgemm_gflops, measure_machine, peak_memory_bytes, triad_bandwidth, Machine};
+pub use report::markdown;
+
+use crate::Error;
+use serde::Serialize;
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// Presets to run, in order: "S", "M", "L".
+    pub cells: Vec<String>,
+    /// Seed of the generator.
+    pub seed: u64,
+    /// Repeats of each timed stage (the median is reported).
+    pub repeats: usize,
+    /// Increments of the elasto-plastic curve (0: skip it).
+    pub curve_steps: usize,
+    /// Macroscopic ε11 at the end of the curve.
+    pub curve_strain: f64,
+    /// Tresca bound of the contacts in the curve (N); the curve runs on bonded contacts (see
+    /// [`crate::solve::IncrementalOptions::bonded`]).
+    pub tresca_bound: f64,
+}
+
+impl Default for BenchOptions {
+    fn default() -> Self {
+        BenchOptions {
+            cells: vec!["S".into(), "M".into()],
+            seed: 1,
+            repeats: 3,
+            curve_steps: 100,
+            curve_strain: 2e-3,
+            tresca_bound: 1e-4,
+        }
+    }
+}
+
+/// Everything the benchmark measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    /// fibercell version.
+    pub version: &'static str,
+    /// The machine and its limits.
+    pub machine: Machine,
+    /// Seed, repeats and curve settings.
+    pub seed: u64,
+    /// Repeats per stage.
+    pub repeats: usize,
+    /// One entry per cell.
+    pub cells: Vec<CellBench>,
+}
+
+/// Measures the machine, then every cell of `opts`; `log` hears what is being run.
+pub fn run_bench(opts: &BenchOptions, log: &mut dyn FnMut(&str)) -> Result<BenchReport, Error> {
+    if opts.repeats == 0 {
+        return Err(Error::InvalidOption("repeats must be at least 1".into()));
+    }
+    if !(opts.curve_strain.is_finite() && opts.tresca_bound.is_finite() && opts.tresca_bound >= 0.0)
+    {
+        return Err(Error::InvalidOption(
+            "curve strain and Tresca bound must be finite, the bound ≥ 0".into(),
+        ));
+    }
+    log("machine: DGEMM and memory bandwidth");
+    let machine = measure_machine(2048, 1 << 25);
+    let mut cells = Vec::new();
+    for c in &opts.cells {
+        cells.push(bench_cell(c, opts, &machine, log)?);
+    }
+    Ok(BenchReport {
+        version: env!("CARGO_PKG_VERSION"),
+        machine,
+        seed: opts.seed,
+        repeats: opts.repeats,
+        cells,
+    })
+}

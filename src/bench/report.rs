@@ -1,0 +1,167 @@
+//! The benchmark report as Markdown tables: printed by `fibercell bench` and pasted into the
+//! README's performance section.
+
+use super::BenchReport;
+use std::fmt::Write;
+
+fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
+    v.map_or("–".into(), |v| v.to_string())
+}
+
+fn ms(s: f64) -> String {
+    if s >= 10.0 {
+        format!("{s:.1} s")
+    } else if s >= 1.0 {
+        format!("{s:.2} s")
+    } else {
+        format!("{:.1} ms", s * 1e3)
+    }
+}
+
+fn per_second(v: f64) -> String {
+    format!("{:.2e}/s", v)
+}
+
+/// The whole report as Markdown.
+pub fn markdown(r: &BenchReport) -> String {
+    let m = &r.machine;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Machine: {}, {} threads, {} GiB. DGEMM {:.1} GFLOP/s on one thread, {:.1} on {}; \
+         STREAM triad {:.1} GB/s. fibercell {}, seed {}, medians of {} runs.\n",
+        m.cpu,
+        m.threads,
+        opt(m.memory_gib.map(|g| format!("{g:.0}"))),
+        m.dgemm_gflops_1,
+        m.dgemm_gflops_all,
+        m.threads,
+        m.bandwidth_gbs,
+        r.version,
+        r.seed,
+        r.repeats
+    );
+    let _ = writeln!(
+        s,
+        "| stage | {} |",
+        r.cells
+            .iter()
+            .map(|c| c.cell.as_str())
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
+    let _ = writeln!(s, "|---|{}", "---:|".repeat(r.cells.len()));
+    let mut row = |name: &str, f: &dyn Fn(&super::CellBench) -> String| {
+        let cols: Vec<String> = r.cells.iter().map(f).collect();
+        let _ = writeln!(s, "| {name} | {} |", cols.join(" | "));
+    };
+    row("fibers / elements", &|c| {
+        format!("{} / {}", c.fibers, c.elements)
+    });
+    row("closed contacts", &|c| c.contacts.to_string());
+    row("free DOFs / nnz(K)", &|c| {
+        format!("{} / {:.2e}", c.dofs, c.nnz_k as f64)
+    });
+    row("generation", &|c| ms(c.generation));
+    row("contact search (segments/s)", &|c| {
+        format!(
+            "{} ({})",
+            ms(c.contact_search),
+            per_second(c.segments_per_second)
+        )
+    });
+    row("contact set (merge, kinematics)", &|c| ms(c.contact_set));
+    row("pattern", &|c| ms(c.pattern));
+    row("value fill, elements (elements/s)", &|c| {
+        format!(
+            "{} ({})",
+            ms(c.fill_elements),
+            per_second(c.elements_per_second)
+        )
+    });
+    row("value fill, contacts (pairs/s)", &|c| {
+        format!(
+            "{} ({})",
+            ms(c.fill_contacts),
+            per_second(c.pairs_per_second)
+        )
+    });
+    row("value fill: fraction of bandwidth", &|c| {
+        format!("{:.1} %", 100.0 * c.fill_fraction_of_bandwidth)
+    });
+    row("six cell problems (+ Θ), end to end", &|c| {
+        ms(c.six_cell_problems)
+    });
+    row("curve: increments, total", &|c| {
+        c.curve.as_ref().map_or("–".into(), |k| match &k.error {
+            Some(e) => format!("failed: {e}"),
+            None => format!("{}, {}", k.steps, ms(k.total)),
+        })
+    });
+    row("curve: one increment (median / max)", &|c| {
+        c.curve.as_ref().map_or("–".into(), |k| {
+            format!("{} / {}", ms(k.increment_median), ms(k.increment_max))
+        })
+    });
+    row("curve: factorizations / factor reuses", &|c| {
+        c.curve.as_ref().map_or("–".into(), |k| {
+            format!("{} / {}", k.factorizations, k.factor_reuses)
+        })
+    });
+    row("curve: sliding at end / held", &|c| {
+        c.curve.as_ref().map_or("–".into(), |k| {
+            format!("{} / {}", k.sliding_at_end, k.held)
+        })
+    });
+    row("peak memory", &|c| {
+        opt(c.peak_memory.map(|b| format!("{:.2} GB", b as f64 / 1e9)))
+    });
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "| cell | backend | ordering | analyze | factorize | solve | nnz(L) | GFLOP/s | of DGEMM | solve of bandwidth |"
+    );
+    let _ = writeln!(s, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    for c in &r.cells {
+        for b in &c.backends {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                c.cell,
+                b.name,
+                b.ordering,
+                ms(b.analyze),
+                ms(b.factorize),
+                ms(b.solve),
+                opt(b.nnz_l.map(|v| format!("{:.3e}", v as f64))),
+                opt(b.gflops.map(|v| format!("{v:.1}"))),
+                opt(b.fraction_of_dgemm.map(|v| format!("{:.0} %", 100.0 * v))),
+                opt(b
+                    .solve_fraction_of_bandwidth
+                    .map(|v| format!("{:.0} %", 100.0 * v))),
+            );
+        }
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "| cell | contacts switched | fraction | CG iterations | seconds | of a refactorization |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|");
+    for c in &r.cells {
+        for u in &c.reuse {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.1} % | {}{} | {} | {:.2} |",
+                c.cell,
+                u.switched,
+                100.0 * u.fraction,
+                u.iterations,
+                if u.converged { "" } else { " (not converged)" },
+                ms(u.seconds),
+                u.ratio_to_refactorization
+            );
+        }
+    }
+    s
+}
