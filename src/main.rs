@@ -84,6 +84,14 @@ enum Command {
         /// Directory for curve.csv, switches.csv, curve.json and curve.svg.
         #[arg(short, long, default_value = "fibercell-results")]
         output: PathBuf,
+        /// Bonded contacts: closed ones never open, open ones never close; only stick and
+        /// slip evolve (for just-touching mats such as the generated non-wovens).
+        #[arg(long)]
+        bonded: bool,
+        /// Relative stiffness of stabilizing springs on open and sliding contacts (e.g. 1e-8),
+        /// so fibers that lose their hold do not make the system singular.
+        #[arg(long, default_value_t = 0.0)]
+        stabilization: f64,
     },
     /// Generate a periodic fabric cell and print its statistics.
     Generate {
@@ -640,7 +648,7 @@ fn homogenize(
 fn curve(
     model_path: &Path,
     (strain, steps, unload): (fibercell::cell::MacroStrain, usize, bool),
-    solver: SolverKind,
+    (solver, bonded, stabilization): (SolverKind, bool, f64),
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
@@ -649,6 +657,8 @@ fn curve(
     let (bar, progress) = progress_bar("curve");
     let mut incremental = IncrementalOptions {
         progress: Some(progress),
+        bonded,
+        stabilization,
         ..IncrementalOptions::default()
     };
     incremental.solve.solver = solver;
@@ -977,7 +987,15 @@ fn main() -> ExitCode {
             solver,
             json,
             output,
-        } => curve(&model, (strain, steps, unload), solver, json, &output),
+            bonded,
+            stabilization,
+        } => curve(
+            &model,
+            (strain, steps, unload),
+            (solver, bonded, stabilization),
+            json,
+            &output,
+        ),
         Command::Generate { kind } => generate(kind),
         Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),
         Command::Convert { input, output } => convert(&input, &output),

@@ -44,7 +44,11 @@ fn a_rank_k_change_converges_in_k_plus_one_iterations() {
             .collect();
         let a = grid(m, &bumps);
         let r = pcg_with_factor(&mut factor, a.as_ref(), &b, 1e-13, 100).expect("pcg");
-        assert!(r.converged, "k = {k}: backward error {:e}", r.backward_error);
+        assert!(
+            r.converged,
+            "k = {k}: backward error {:e}",
+            r.backward_error
+        );
         // k + 1 in exact arithmetic; loss of orthogonality in floating point costs a few more
         // (measured: 0, 1, 3, 12 for k = 0, 1, 3, 8).
         assert!(

@@ -104,18 +104,20 @@ fn cell(bound: f64) -> ModelDescription {
 
 const SHEAR: [f64; 6] = [0.0, 0.0, 0.01, 0.0, 0.0, 0.0];
 
+fn run(d: &ModelDescription, options: CurveOptions) -> Curve {
+    elasto_plastic_curve(&Model::from_description(d).unwrap(), &options).unwrap()
+}
+
 fn curve(d: &ModelDescription, steps: usize, unload: bool) -> Curve {
-    let m = Model::from_description(d).unwrap();
-    elasto_plastic_curve(
-        &m,
-        &CurveOptions {
+    run(
+        d,
+        CurveOptions {
             strain: SHEAR,
             steps,
             unload,
             incremental: IncrementalOptions::default(),
         },
     )
-    .unwrap()
 }
 
 #[test]
@@ -229,5 +231,119 @@ fn bad_macro_strain_is_an_error() {
     assert!(
         matches!(e, Error::InvalidOption(_)) && e.to_string().contains("not finite"),
         "{e}"
+    );
+}
+
+fn curve_with(d: &ModelDescription, strain: [f64; 6], incremental: IncrementalOptions) -> Curve {
+    let steps = 3;
+    let unload = false;
+    run(
+        d,
+        CurveOptions {
+            strain,
+            steps,
+            unload,
+            incremental,
+        },
+    )
+}
+
+/// Bonded (fixed-topology) contacts never open: under the curvature κ22, which moves the link
+/// normal to the contact, the all-stick curve is A^elas E for either sign, the contact carrying
+/// compression one way and tension the other; unbonded, it opens under the tensile sign.
+#[test]
+fn bonded_contacts_carry_tension_and_stay_linear_both_ways() {
+    let d = cell(1e6);
+    let h = homogenize_elastic(
+        &Model::from_description(&d).unwrap(),
+        &SolveOptions::default(),
+    )
+    .unwrap();
+    let bonded = IncrementalOptions {
+        bonded: true,
+        ..IncrementalOptions::default()
+    };
+    let mut normal_signs = Vec::new();
+    const BEND: [f64; 6] = [0.0, 0.0, 0.0, 0.0, 0.01, 0.0];
+    for sign in [1.0, -1.0] {
+        let strain = BEND.map(|v| sign * v);
+        let c = curve_with(&d, strain, bonded.clone());
+        for p in &c.points {
+            assert_eq!(p.stick, 1);
+            for i in 0..6 {
+                let want: f64 = (0..6).map(|j| h.abd[i][j] * p.strain[j]).sum();
+                assert!(
+                    (p.resultant[i] - want).abs() <= 1e-8 * h.abd[4][4] * 0.01,
+                    "{i}: {} vs {want}",
+                    p.resultant[i]
+                );
+            }
+        }
+        let last = c.solution.contact_results.last().unwrap();
+        normal_signs.push(last[0].normal_force.signum());
+    }
+    // Compression one way, tension (a negative normal force) the other.
+    assert_eq!(normal_signs[0], -normal_signs[1], "{normal_signs:?}");
+    let tensile = if normal_signs[0] < 0.0 { 1.0 } else { -1.0 };
+    let unbonded = curve_with(&d, BEND.map(|v| tensile * v), IncrementalOptions::default());
+    assert_eq!(unbonded.points.last().unwrap().open, 1);
+}
+
+/// Stabilizing springs of relative stiffness ε change nothing when every contact sticks (they
+/// act on open and sliding contacts only), and change a sliding curve by ε k_T s, where the slip
+/// s is here about 10³ times the elastic tangential jump at the onset: 1e-4 of the resultants
+/// for ε = 1e-8.
+#[test]
+fn stabilization_springs_perturb_the_curve_by_order_epsilon() {
+    for bound in [1e6, 1e-3] {
+        let d = cell(bound);
+        let plain = curve_with(&d, SHEAR, IncrementalOptions::default());
+        let stabilized = curve_with(
+            &d,
+            SHEAR,
+            IncrementalOptions {
+                stabilization: 1e-8,
+                ..IncrementalOptions::default()
+            },
+        );
+        let scale = plain
+            .points
+            .iter()
+            .flat_map(|p| p.resultant)
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0);
+        let sliding = plain.points.last().unwrap().slip;
+        assert_eq!(sliding, usize::from(bound < 1.0), "bound {bound}");
+        let tol = if bound > 1.0 { 0.0 } else { 1e-4 * scale };
+        for (a, b) in plain.points.iter().zip(&stabilized.points) {
+            assert_eq!((a.stick, a.slip), (b.stick, b.slip));
+            for i in 0..6 {
+                assert!(
+                    (a.resultant[i] - b.resultant[i]).abs() <= tol,
+                    "bound {bound}: {i}: {} vs {}",
+                    a.resultant[i],
+                    b.resultant[i]
+                );
+            }
+        }
+    }
+    let bad = IncrementalOptions {
+        stabilization: f64::NAN,
+        ..IncrementalOptions::default()
+    };
+    let m = Model::from_description(&cell(1.0)).unwrap();
+    let err = elasto_plastic_curve(
+        &m,
+        &CurveOptions {
+            strain: SHEAR,
+            steps: 2,
+            unload: false,
+            incremental: bad,
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, Error::InvalidOption(ref s) if s.contains("stabilization")),
+        "{err}"
     );
 }

@@ -73,6 +73,9 @@ pub fn run_bench(opts: &BenchOptions, log: &mut dyn FnMut(&str)) -> Result<Bench
             "curve strain and Tresca bound must be finite, the bound ≥ 0".into(),
         ));
     }
+    for c in &opts.cells {
+        crate::generate::nonwoven_preset(c, opts.seed)?;
+    }
     log("machine: DGEMM and memory bandwidth");
     let machine = measure_machine(2048, 1 << 25);
     let mut cells = Vec::new();

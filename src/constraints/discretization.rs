@@ -143,6 +143,16 @@ impl Discretization {
         self.block_of_images(nodes, &vec![[0, 0]; nodes.len()])
     }
 
+    /// The block of an element's `nodes`, or None when it is the identity (no node is a
+    /// slave: the element acts on its own nodes' DOFs) — the common case, which then needs no
+    /// Tᵀ K T.
+    pub fn non_identity_block(&self, nodes: &[usize]) -> Option<(Vec<usize>, DMatrix<f64>)> {
+        if nodes.iter().all(|&n| self.maps[n].is_none()) {
+            return None;
+        }
+        Some(self.block(nodes))
+    }
+
     /// As [`Discretization::block`] for periodic images of the nodes, shifted by `shifts`
     /// periods: the image of x moves by u(x) + (M(x + sL) − M(x)) E.
     ///

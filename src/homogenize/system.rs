@@ -9,10 +9,11 @@
 use crate::assembly::{element_stiffness, Pattern, NO_SLOT};
 use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain, Periodicity};
 use crate::constraints::Discretization;
-use crate::contact::{ContactPair, ContactSet, ContactSide};
+use crate::contact::{BlockMatrix, ContactPair, ContactSet, ContactSide};
 use crate::model::{Dof, Model};
 use crate::Error;
 use nalgebra::{DMatrix, SMatrix, Vector2};
+use rayon::prelude::*;
 
 /// The assembled values of a periodic cell problem.
 #[derive(Clone, Debug)]
@@ -24,6 +25,9 @@ pub struct PeriodicValues {
     /// K_EE.
     pub k_ee: SMatrix<f64, 6, 6>,
 }
+
+/// Elements or contacts whose matrices are computed in parallel before being scattered.
+const CHUNK: usize = 4096;
 
 /// The tangential state a closed contact enters the cell matrix with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,7 +58,8 @@ pub struct PeriodicSystem {
     pub discretization: Discretization,
     /// Sparsity pattern of K_ff: elements, then closed contacts.
     pub pattern: Pattern,
-    elements: Vec<(Vec<usize>, DMatrix<f64>)>,
+    /// Per element: its generalized nodes and T, None when T = I on its own nodes.
+    elements: Vec<Option<(Vec<usize>, DMatrix<f64>)>>,
     contacts: Vec<ContactPair>,
     /// The node whose translations are fixed.
     pub anchor: usize,
@@ -120,10 +125,10 @@ impl PeriodicSystem {
             .filter(|&i| set.pairs[i].gap <= 0.0)
             .collect();
         let discretization = Discretization::periodic(model, &periodicity, &[0.0; 6], anchor);
-        let elements: Vec<(Vec<usize>, DMatrix<f64>)> = model
+        let elements: Vec<Option<(Vec<usize>, DMatrix<f64>)>> = model
             .elements()
             .iter()
-            .map(|e| discretization.block(&e.nodes))
+            .map(|e| discretization.non_identity_block(&e.nodes))
             .collect();
         let contacts: Vec<ContactPair> = closed
             .iter()
@@ -131,7 +136,8 @@ impl PeriodicSystem {
             .collect();
         let blocks: Vec<&[usize]> = elements
             .iter()
-            .map(|(g, _)| &g[..])
+            .zip(model.elements())
+            .map(|(b, e)| b.as_ref().map_or(&e.nodes[..], |(g, _)| &g[..]))
             .chain(contacts.iter().map(|c| &c.jump.nodes[..]))
             .collect();
         timings.blocks = clock.elapsed().as_secs_f64();
@@ -186,44 +192,72 @@ impl PeriodicSystem {
         }
     }
 
-    /// Adds Tᵀ K T of every element.
+    /// Adds Tᵀ K T of every element. Element matrices are computed in parallel, a chunk at a
+    /// time, and scattered serially (the sums do not depend on the number of threads).
     pub fn add_elements(&self, model: &Model, out: &mut PeriodicValues) {
-        for (e, (gnodes, t)) in self.elements.iter().enumerate() {
-            let k = element_stiffness(model, e);
-            let k = DMatrix::from_fn(12, 12, |r, c| k[(r, c)]);
-            self.scatter(
-                out,
-                gnodes,
-                &(t.transpose() * k * t),
-                self.pattern.element_slots(e),
-            );
+        let els = model.elements();
+        for start in (0..els.len()).step_by(CHUNK) {
+            let end = (start + CHUNK).min(els.len());
+            let mats: Vec<DMatrix<f64>> = (start..end)
+                .into_par_iter()
+                .map(|e| {
+                    let k = element_stiffness(model, e);
+                    match &self.elements[e] {
+                        None => DMatrix::from_fn(12, 12, |r, c| k[(r, c)]),
+                        Some((_, t)) => {
+                            t.transpose() * DMatrix::from_fn(12, 12, |r, c| k[(r, c)]) * t
+                        }
+                    }
+                })
+                .collect();
+            for (e, k) in (start..end).zip(&mats) {
+                let gnodes = self.elements[e]
+                    .as_ref()
+                    .map_or(&els[e].nodes[..], |(g, _)| &g[..]);
+                self.scatter(out, gnodes, k.as_slice(), self.pattern.element_slots(e));
+            }
         }
     }
 
-    /// Adds the closed contacts, contact i with the stiffness `which(i)`.
+    /// Adds the closed contacts, contact i with the stiffness `which(i)`; in parallel chunks as
+    /// [`PeriodicSystem::add_elements`].
     pub fn add_contacts(
         &self,
         out: &mut PeriodicValues,
-        which: impl Fn(usize) -> ContactStiffness,
+        which: impl Fn(usize) -> ContactStiffness + Sync,
     ) {
-        for (i, pair) in self.contacts.iter().enumerate() {
-            let m = pair.size();
-            let (kn, _) = pair.normal();
-            let kr = pair.rotation();
-            let k = match which(i) {
-                ContactStiffness::Stick => {
-                    let (kt, _) = pair.stick(&Vector2::zeros());
-                    kn + kt + kr
-                }
-                ContactStiffness::Sliding => kn + kr,
-            };
-            let k = DMatrix::from_fn(m, m, |r, c| k[(r, c)]);
-            self.scatter(out, &pair.jump.nodes, &k, self.pattern.extra_slots(i));
+        for start in (0..self.contacts.len()).step_by(CHUNK) {
+            let end = (start + CHUNK).min(self.contacts.len());
+            let mats: Vec<BlockMatrix> = (start..end)
+                .into_par_iter()
+                .map(|i| {
+                    let pair = &self.contacts[i];
+                    let (kn, _) = pair.normal();
+                    let kr = pair.rotation();
+                    match which(i) {
+                        ContactStiffness::Stick => {
+                            let (kt, _) = pair.stick(&Vector2::zeros());
+                            kn + kt + kr
+                        }
+                        ContactStiffness::Sliding => kn + kr,
+                    }
+                })
+                .collect();
+            for (i, k) in (start..end).zip(&mats) {
+                let pair = &self.contacts[i];
+                let m = pair.size();
+                // The leading m × m block of the fixed 30 × 30 matrix, column-major.
+                let block: Vec<f64> = (0..m)
+                    .flat_map(|c| (0..m).map(move |r| k[(r, c)]))
+                    .collect();
+                self.scatter(out, &pair.jump.nodes, &block, self.pattern.extra_slots(i));
+            }
         }
     }
 
-    /// Adds the block `k` on generalized nodes `gnodes` through its pattern `slots`.
-    fn scatter(&self, out: &mut PeriodicValues, gnodes: &[usize], k: &DMatrix<f64>, slots: &[u32]) {
+    /// Adds the column-major m × m block `k` on generalized nodes `gnodes` (m = 6 per node)
+    /// through its pattern `slots`.
+    fn scatter(&self, out: &mut PeriodicValues, gnodes: &[usize], k: &[f64], slots: &[u32]) {
         let disc = &self.discretization;
         let driver = disc.driver().unwrap_or(usize::MAX);
         let m = 6 * gnodes.len();
@@ -231,7 +265,7 @@ impl PeriodicSystem {
         for r in 0..m {
             let driver_r = gnodes[r / 6] == driver;
             for c in 0..m {
-                let v = k[(r, c)];
+                let v = k[c * m + r];
                 let driver_c = gnodes[c / 6] == driver;
                 match (driver_r, driver_c) {
                     (true, true) => out.k_ee[(r % 6, c % 6)] += v,

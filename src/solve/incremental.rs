@@ -29,6 +29,7 @@ use fibercell_solver::{
     SolveReport, SolverError,
 };
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// A callback told after every increment: (increments done, increments in all).
@@ -71,7 +72,8 @@ pub struct IncrementalOptions {
     /// evolve, with a Coulomb bound μ max(N, 0). A model of bonded or consolidated mats, whose
     /// just-touching contacts would otherwise open under the smallest strain and chatter.
     pub bonded: bool,
-    /// After a few contacts changed state (at most 1 % of them), solve by CG preconditioned with
+    /// After a few contacts changed state (at most 1 % of them; changes of slip directions and
+    /// of the tangent across them do not count), solve by CG preconditioned with
     /// the last symmetric factorization instead of refactorizing, within an iteration budget of
     /// a tenth of a factorization's flops (refactorizing once the iterations spent on one
     /// factorization add up to about its cost); fall back to a factorization when CG does not reach
@@ -344,11 +346,10 @@ fn stabilizer(pair: &ContactPair, state: ContactState) -> BlockMatrix {
     }
 }
 
-/// Contacts whose state, slip direction or k⊥ differ between two assembled keys.
-fn differing_contacts(a: &AssembledKey, b: &AssembledKey) -> usize {
-    (0..a.1.len())
-        .filter(|&i| a.1[i] != b.1[i] || a.2[i] != b.2[i] || a.3[i] != b.3[i])
-        .count()
+/// Contacts whose state (open, stick, slip) differs between two assembled keys. Changes of a
+/// slip direction or of k⊥ alone are small perturbations, left to the iteration budget.
+fn differing_states(a: &AssembledKey, b: &AssembledKey) -> usize {
+    (0..a.1.len()).filter(|&i| a.1[i] != b.1[i]).count()
 }
 
 /// CG iterations preconditioned by a factorization that cost at most a tenth of refactorizing:
@@ -384,6 +385,8 @@ pub fn solve_incremental(
 struct Elastic {
     /// Generalized nodes and T of every element (None: the element's own nodes, T = I).
     maps: Vec<Option<(Vec<usize>, DMatrix<f64>)>>,
+    /// The discretization is the identity (a supported structure).
+    identity: bool,
 }
 
 impl Elastic {
@@ -393,8 +396,15 @@ impl Elastic {
             maps: model
                 .elements()
                 .iter()
-                .map(|e| (!identity).then(|| disc.block(&e.nodes)))
+                .map(|e| {
+                    if identity {
+                        None
+                    } else {
+                        disc.non_identity_block(&e.nodes)
+                    }
+                })
                 .collect(),
+            identity,
         }
     }
 
@@ -415,6 +425,22 @@ impl Elastic {
         }
     }
 
+    /// (element, Tᵀ K T) of every element in order, computed in parallel chunks.
+    fn matrices<'a>(
+        &'a self,
+        model: &'a Model,
+    ) -> impl Iterator<Item = (usize, DMatrix<f64>)> + 'a {
+        const CHUNK: usize = 4096;
+        (0..self.maps.len()).step_by(CHUNK).flat_map(move |start| {
+            let end = (start + CHUNK).min(self.maps.len());
+            let mats: Vec<DMatrix<f64>> = (start..end)
+                .into_par_iter()
+                .map(|e| self.matrix(model, e))
+                .collect();
+            (start..end).zip(mats)
+        })
+    }
+
     fn fill(
         &self,
         model: &Model,
@@ -422,13 +448,12 @@ impl Elastic {
         values: &mut [f64],
         mode: crate::assembly::FillMode,
     ) -> Result<(), Error> {
-        if self.maps.iter().all(|m| m.is_none()) {
+        if self.identity {
             Assembler::new(model).fill(model, pattern, values, mode)?;
             return Ok(());
         }
         values.iter_mut().for_each(|v| *v = 0.0);
-        for e in 0..self.maps.len() {
-            let k = self.matrix(model, e);
+        for (e, k) in self.matrices(model) {
             let m = k.nrows();
             let slots = pattern.element_slots(e);
             for r in 0..m {
@@ -482,13 +507,12 @@ impl Elastic {
 
     /// Generalized internal forces K q for the full generalized vector q.
     fn internal(&self, model: &Model, q: &[f64]) -> Vec<f64> {
-        if self.maps.iter().all(|m| m.is_none()) {
+        if self.identity {
             return internal_forces(model, &q[..6 * model.nodes.len()]);
         }
         let mut out = vec![0.0; q.len()];
-        for e in 0..self.maps.len() {
+        for (e, k) in self.matrices(model) {
             let gnodes = self.gnodes(model, e);
-            let k = self.matrix(model, e);
             let qe = DVector::from_fn(6 * gnodes.len(), |c, _| q[6 * gnodes[c / 6] + c % 6]);
             let f = k * qe;
             for (r, v) in f.iter().enumerate() {
@@ -652,23 +676,27 @@ pub(crate) fn run_incremental(
             // Assemble K + K_N + K_T and α F + F_N + F_T for the current states.
             values.copy_from_slice(&k_elastic);
             let mut rhs: Vec<f64> = rhs_full.iter().map(|v| alpha * v).collect();
-            let mut closed: Vec<&[usize]> = Vec::new();
-            let mut nonsymmetric = false;
-            for (i, pair) in pairs.iter().enumerate() {
-                let (k, f) = match states[i] {
-                    ContactState::Open if stabilization > 0.0 => (
+            let closed: Vec<&[usize]> = (0..pairs.len())
+                .filter(|&i| states[i] != ContactState::Open)
+                .map(|i| &set.pairs[i].jump.nodes[..])
+                .collect();
+            let nonsymmetric = matches!(friction, Friction::Coulomb { mu } if mu > 0.0)
+                && states.contains(&ContactState::Slip);
+            // The contact blocks for the current states, computed in parallel chunks and
+            // scattered serially (sums independent of the number of threads).
+            let block = |i: usize| -> Option<(BlockMatrix, BlockVector)> {
+                let pair = &pairs[i];
+                match states[i] {
+                    ContactState::Open if stabilization > 0.0 => Some((
                         stabilizer(pair, states[i]) * stabilization,
                         BlockVector::zeros(),
-                    ),
-                    ContactState::Open => continue,
+                    )),
+                    ContactState::Open => None,
                     state => {
-                        closed.push(&set.pairs[i].jump.nodes);
                         let (mut k, mut f) = pair.normal();
                         let (kt, ft) = match state {
                             ContactState::Stick => pair.stick(&slips[i]),
                             _ => {
-                                nonsymmetric |=
-                                    matches!(friction, Friction::Coulomb { mu } if mu > 0.0);
                                 let (mut k, mut f) = pair.slip(friction, &directions[i]);
                                 if perpendicular[i].0 > 0.0 {
                                     let (kp, fp) = pair.slip_perpendicular(
@@ -687,23 +715,33 @@ pub(crate) fn run_incremental(
                         };
                         k += kt + pair.rotation();
                         f += ft;
-                        (k, f)
+                        Some((k, f))
                     }
-                };
-                let m = pair.size();
-                let slots = pattern.extra_slots(i);
-                let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
-                for r in 0..m {
-                    let Some(ir) = disc.reduced(gdof(r)) else {
-                        continue;
-                    };
-                    rhs[ir] += f[r];
-                    for c in 0..m {
-                        let s = slots[r * m + c];
-                        if s != NO_SLOT {
-                            values[s as usize] += k[(r, c)];
-                        } else if disc.reduced(gdof(c)).is_none() {
-                            rhs[ir] -= k[(r, c)] * alpha * disc.prescribed_value(gdof(c));
+                }
+            };
+            const CHUNK: usize = 2048;
+            for start in (0..pairs.len()).step_by(CHUNK) {
+                let end = (start + CHUNK).min(pairs.len());
+                let blocks: Vec<Option<(BlockMatrix, BlockVector)>> =
+                    (start..end).into_par_iter().map(block).collect();
+                for (i, b) in (start..end).zip(blocks) {
+                    let Some((k, f)) = b else { continue };
+                    let pair = &pairs[i];
+                    let m = pair.size();
+                    let slots = pattern.extra_slots(i);
+                    let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
+                    for r in 0..m {
+                        let Some(ir) = disc.reduced(gdof(r)) else {
+                            continue;
+                        };
+                        rhs[ir] += f[r];
+                        for c in 0..m {
+                            let s = slots[r * m + c];
+                            if s != NO_SLOT {
+                                values[s as usize] += k[(r, c)];
+                            } else if disc.reduced(gdof(c)).is_none() {
+                                rhs[ir] -= k[(r, c)] * alpha * disc.prescribed_value(gdof(c));
+                            }
                         }
                     }
                 }
@@ -739,13 +777,12 @@ pub(crate) fn run_incremental(
             // update); otherwise, or when CG does not converge within its budget, refactorize.
             let mut reused = None;
             if let Some(old) = factorized.as_ref().filter(|_| n_free > 0) {
-                let differing = differing_contacts(old, &key);
                 if opts.reuse_factor
                     && !nonsymmetric
                     && !old.0
+                    && *old != key
                     && reuse_budget > 0
-                    && differing > 0
-                    && differing <= (pairs.len() / 100).max(1)
+                    && differing_states(old, &key) <= (pairs.len() / 100).max(1)
                     && spent_since_factor < 10 * reuse_budget
                 {
                     let tol = 1e-3 * backward_tolerance(&opts.solve);

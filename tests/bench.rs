@@ -1,0 +1,74 @@
+//! The throughput benchmark's library entry point on the small preset: every stage is measured
+//! and consistent with the others (same matrix for every backend, the factor-reuse solve
+//! converges after one switch, the curve runs), and bad options are typed errors.
+
+use fibercell::bench::{markdown, run_bench, BenchOptions};
+use fibercell::Error;
+
+#[test]
+fn the_small_cell_runs_every_stage() {
+    let opts = BenchOptions {
+        cells: vec!["S".into()],
+        repeats: 1,
+        curve_steps: 2,
+        ..BenchOptions::default()
+    };
+    let mut log = Vec::new();
+    let r = run_bench(&opts, &mut |s| log.push(s.to_string())).expect("bench");
+    assert!(r.machine.dgemm_gflops_1 > 0.0 && r.machine.dgemm_gflops_all > 0.0);
+    assert!(r.machine.bandwidth_gbs > 0.0);
+    let c = &r.cells[0];
+    assert_eq!(c.cell, "S");
+    assert!(
+        c.fibers >= 150 && c.contacts > 500,
+        "{} fibers, {} contacts",
+        c.fibers,
+        c.contacts
+    );
+    // Entries of K: at least the 12×12 element blocks' distinct couplings of 6×6 node blocks.
+    assert!(c.nnz_k >= 36 * (c.dofs / 6));
+    for t in [
+        c.generation,
+        c.contact_search,
+        c.pattern,
+        c.fill_elements,
+        c.fill_contacts,
+    ] {
+        assert!(t > 0.0 && t.is_finite());
+    }
+    assert!(!c.backends.is_empty());
+    for b in &c.backends {
+        let l = b.nnz_l.expect("direct backends report nnz(L)");
+        // L holds at least the lower triangle of K.
+        assert!(l >= (c.nnz_k + c.dofs) / 2, "{}: nnz(L) {l}", b.name);
+        assert!(b.factorize > 0.0 && b.solve > 0.0);
+    }
+    let one = &c.reuse[0];
+    assert_eq!(one.switched, 1);
+    assert!(one.converged && one.iterations >= 1, "{one:?}");
+    let curve = c.curve.as_ref().expect("curve ran");
+    assert_eq!(curve.error, None);
+    assert!(curve.factorizations >= 1);
+    let text = markdown(&r);
+    assert!(text.contains("| six cell problems"));
+    assert!(log.iter().any(|l| l.contains("S: six cell problems")));
+}
+
+#[test]
+fn unknown_cells_and_bad_options_are_typed_errors() {
+    let bad_cell = BenchOptions {
+        cells: vec!["XL".into()],
+        curve_steps: 0,
+        ..BenchOptions::default()
+    };
+    let err = run_bench(&bad_cell, &mut |_| {}).unwrap_err();
+    assert!(err.to_string().contains("XL"), "{err}");
+    let no_repeats = BenchOptions {
+        repeats: 0,
+        ..BenchOptions::default()
+    };
+    assert!(matches!(
+        run_bench(&no_repeats, &mut |_| {}),
+        Err(Error::InvalidOption(_))
+    ));
+}
