@@ -138,6 +138,16 @@ enum Command {
         /// Increments of the elasto-plastic curve (0: skip it).
         #[arg(long, default_value_t = 100)]
         curve_steps: usize,
+        /// Wall-clock limit of one curve in seconds: it stops there and the rest is projected.
+        #[arg(long, default_value_t = 1200.0)]
+        curve_time_limit: f64,
+        /// Do not run: render the report of an earlier --json file.
+        #[arg(long)]
+        from_json: Option<PathBuf>,
+        /// Replace the README's performance tables (between the bench:start and bench:end
+        /// markers) with this report.
+        #[arg(long)]
+        readme: Option<PathBuf>,
     },
     /// Write the reduced stiffness matrix in Matrix Market form (symmetric, lower triangle).
     ExportMatrix {
@@ -372,12 +382,52 @@ fn parse_ordering(s: &str) -> Result<Ordering, String> {
 
 fn bench(
     opts: fibercell::bench::BenchOptions,
-    json: Option<&Path>,
-    markdown: Option<&Path>,
+    from_json: Option<&Path>,
+    [json, markdown, readme]: [Option<&Path>; 3],
 ) -> Result<(), Error> {
-    let report = fibercell::bench::run_bench(&opts, &mut |what| eprintln!("bench: {what}"))?;
-    let text = fibercell::bench::markdown(&report);
+    use fibercell::bench;
+    let report: bench::BenchReport = match from_json {
+        Some(p) => {
+            let text = io::read_text(p)?;
+            serde_json::from_str(&text).map_err(|e| {
+                Error::InvalidOption(format!("{}: not a bench report: {e}", p.display()))
+            })?
+        }
+        None => bench::run_bench(&opts, &mut |what| eprintln!("bench: {what}"))?,
+    };
+    let text = bench::markdown(&report);
     println!("{text}");
+    if let Some(p) = readme {
+        let old = io::read_text(p)?;
+        let cells: Vec<&str> = report.cells.iter().map(|c| c.cell.as_str()).collect();
+        let cholmod = report
+            .cells
+            .iter()
+            .flat_map(|c| &c.backends)
+            .any(|b| b.name.contains("cholmod"));
+        let steps = report
+            .cells
+            .iter()
+            .find_map(|c| c.curve.as_ref())
+            .map_or(0, |k| k.steps);
+        let command = format!(
+            "cargo run --release{} -- bench --cells {} --repeats {} --seed {} --curve-steps {steps} \
+             --json bench.json --readme README.md",
+            if cholmod { " --features cholmod" } else { "" },
+            cells.join(","),
+            report.repeats,
+            report.seed
+        );
+        let new = bench::splice_readme(&old, &text, &command).ok_or_else(|| {
+            Error::InvalidOption(format!(
+                "{}: no {} … {} markers",
+                p.display(),
+                bench::README_MARKERS[0],
+                bench::README_MARKERS[1]
+            ))
+        })?;
+        write(p, &new)?;
+    }
     if let Some(p) = json {
         let doc = serde_json::to_string_pretty(&report)
             .map_err(|e| Error::InvalidOption(format!("cannot serialize the report: {e}")))?;
@@ -1007,16 +1057,20 @@ fn main() -> ExitCode {
             repeats,
             seed,
             curve_steps,
+            curve_time_limit,
+            from_json,
+            readme,
         } => bench(
             fibercell::bench::BenchOptions {
                 cells,
                 seed,
                 repeats,
                 curve_steps,
+                curve_time_limit: Some(curve_time_limit),
                 ..Default::default()
             },
-            json.as_deref(),
-            markdown.as_deref(),
+            from_json.as_deref(),
+            [json.as_deref(), markdown.as_deref(), readme.as_deref()],
         ),
     };
     match r {

@@ -2,7 +2,7 @@
 //! and consistent with the others (same matrix for every backend, the factor-reuse solve
 //! converges after one switch, the curve runs), and bad options are typed errors.
 
-use fibercell::bench::{markdown, run_bench, BenchOptions};
+use fibercell::bench::{markdown, run_bench, splice_readme, BenchOptions};
 use fibercell::Error;
 
 #[test]
@@ -11,6 +11,8 @@ fn the_small_cell_runs_every_stage() {
         cells: vec!["S".into()],
         repeats: 1,
         curve_steps: 2,
+        // Stops the curve after its first increment; the second is projected.
+        curve_time_limit: Some(1e-6),
         ..BenchOptions::default()
     };
     let mut log = Vec::new();
@@ -49,8 +51,11 @@ fn the_small_cell_runs_every_stage() {
     let curve = c.curve.as_ref().expect("curve ran");
     assert_eq!(curve.error, None);
     assert!(curve.factorizations >= 1);
+    assert_eq!((curve.completed, curve.steps), (1, 2));
+    assert!(curve.projected_total > curve.total, "{curve:?}");
     let text = markdown(&r);
     assert!(text.contains("| six cell problems"));
+    assert!(text.contains("1 of 2 in"), "{text}");
     assert!(log.iter().any(|l| l.contains("S: six cell problems")));
 }
 
@@ -71,4 +76,23 @@ fn unknown_cells_and_bad_options_are_typed_errors() {
         run_bench(&no_repeats, &mut |_| {}),
         Err(Error::InvalidOption(_))
     ));
+}
+
+#[test]
+fn the_readme_tables_are_spliced_between_the_markers_only() {
+    let readme = "# T\n\nbefore\n<!-- bench:start -->\nold table\n<!-- bench:end -->\nafter\n";
+    let new = splice_readme(readme, "| a | b |\n", "fibercell bench").expect("markers");
+    assert_eq!(
+        new,
+        "# T\n\nbefore\n<!-- bench:start -->\n\nReproduce: `fibercell bench`\n\n| a | b |\n\
+         <!-- bench:end -->\nafter\n"
+    );
+    // Splicing again replaces, it does not accumulate.
+    assert_eq!(
+        splice_readme(&new, "| a | b |\n", "fibercell bench"),
+        Some(new.clone())
+    );
+    assert_eq!(splice_readme("no markers", "x", "c"), None);
+    let reversed = "<!-- bench:end -->\n<!-- bench:start -->\n";
+    assert_eq!(splice_readme(reversed, "x", "c"), None);
 }

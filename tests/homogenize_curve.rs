@@ -347,3 +347,22 @@ fn stabilization_springs_perturb_the_curve_by_order_epsilon() {
         "{err}"
     );
 }
+
+/// A deadline already past stops the curve after its first increment; without one every
+/// increment runs, and the first point is the same either way.
+#[test]
+fn a_past_deadline_stops_the_curve_after_one_increment() {
+    let d = cell(1e6);
+    let full = curve_with(&d, SHEAR, IncrementalOptions::default());
+    let boxed = curve_with(
+        &d,
+        SHEAR,
+        IncrementalOptions {
+            deadline: Some(std::time::Instant::now()),
+            ..IncrementalOptions::default()
+        },
+    );
+    assert_eq!(full.points.len(), 3);
+    assert_eq!(boxed.points.len(), 1);
+    assert_eq!(boxed.points[0].resultant, full.points[0].resultant);
+}

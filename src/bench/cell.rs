@@ -15,7 +15,7 @@ use crate::model::{FrictionSpec, Model};
 use crate::solve::{make_solver, IncrementalOptions, SolveOptions, SolverKind};
 use crate::Error;
 use fibercell_solver::{pcg_with_factor, CscRef, Ordering};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// Median of `repeats` timings of `f` (seconds), with the last result.
@@ -36,7 +36,7 @@ fn median_of<T>(
 }
 
 /// One backend on the cell-problem matrix.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BackendBench {
     /// Backend and requested ordering, e.g. "faer-cholesky/auto".
     pub name: String,
@@ -63,7 +63,7 @@ pub struct BackendBench {
 
 /// The solve after k contacts switched stick → sliding, by CG preconditioned with the factor of
 /// the unswitched matrix, against a refactorization.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ReuseBench {
     /// Contacts switched.
     pub switched: usize,
@@ -80,7 +80,7 @@ pub struct ReuseBench {
 }
 
 /// The incremental elasto-plastic curve.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CurveBench {
     /// Increments.
     pub steps: usize,
@@ -88,8 +88,13 @@ pub struct CurveBench {
     pub strain: f64,
     /// Tresca bound of the contacts (N).
     pub tresca_bound: f64,
+    /// Increments done: fewer than `steps` when the time limit stopped the curve.
+    pub completed: usize,
     /// Whole curve including its all-stick elastic homogenization (s).
     pub total: f64,
+    /// `total` with the missing increments at the mean time of the completed ones (s); equals
+    /// `total` when every increment ran.
+    pub projected_total: f64,
     /// Median increment (s).
     pub increment_median: f64,
     /// Slowest increment (s).
@@ -109,7 +114,7 @@ pub struct CurveBench {
 }
 
 /// Every stage of one cell.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CellBench {
     /// S, M or L.
     pub cell: String,
@@ -299,6 +304,9 @@ fn bench_curve(
         incremental: IncrementalOptions {
             bonded: true,
             stabilization: 1e-8,
+            deadline: opts
+                .curve_time_limit
+                .map(|s| Instant::now() + std::time::Duration::from_secs_f64(s)),
             ..IncrementalOptions::default()
         },
     };
@@ -309,7 +317,9 @@ fn bench_curve(
         steps: opts.curve_steps,
         strain: opts.curve_strain,
         tresca_bound: opts.tresca_bound,
+        completed: 0,
         total,
+        projected_total: total,
         increment_median: 0.0,
         increment_max: 0.0,
         state_iterations: 0,
@@ -323,6 +333,12 @@ fn bench_curve(
         Ok(c) => {
             let inc = &c.solution.increments;
             let mut secs: Vec<f64> = inc.iter().map(|r| r.seconds).collect();
+            let spent: f64 = secs.iter().sum();
+            bench.completed = inc.len();
+            if !inc.is_empty() {
+                bench.projected_total =
+                    total - spent + spent / inc.len() as f64 * opts.curve_steps as f64;
+            }
             secs.sort_by(f64::total_cmp);
             bench.increment_median = secs.get(secs.len() / 2).copied().unwrap_or(0.0);
             bench.increment_max = secs.last().copied().unwrap_or(0.0);

@@ -4,11 +4,11 @@
 
 use faer::{linalg::matmul::matmul, Accum, Mat, Par};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// What the machine is and what it can do.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Machine {
     /// CPU model name (from /proc/cpuinfo where available).
     pub cpu: String,

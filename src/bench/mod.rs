@@ -11,10 +11,10 @@ mod report;
 
 pub use cell::{bench_cell, BackendBench, CellBench, CurveBench, ReuseBench};
 pub use machine::{dgemm_gflops, measure_machine, peak_memory_bytes, triad_bandwidth, Machine};
-pub use report::markdown;
+pub use report::{markdown, splice_readme, README_MARKERS};
 
 use crate::Error;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -29,6 +29,9 @@ pub struct BenchOptions {
     pub curve_steps: usize,
     /// Macroscopic ε11 at the end of the curve.
     pub curve_strain: f64,
+    /// Wall-clock limit of one curve (s): it stops after the increment that passes it and the
+    /// report projects the rest (None: no limit).
+    pub curve_time_limit: Option<f64>,
     /// Tresca bound of the contacts in the curve (N); the curve runs on bonded contacts (see
     /// [`crate::solve::IncrementalOptions::bonded`]).
     pub tresca_bound: f64,
@@ -43,15 +46,16 @@ impl Default for BenchOptions {
             curve_steps: 100,
             curve_strain: 2e-3,
             tresca_bound: 1e-4,
+            curve_time_limit: Some(1200.0),
         }
     }
 }
 
 /// Everything the benchmark measured.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BenchReport {
     /// fibercell version.
-    pub version: &'static str,
+    pub version: String,
     /// The machine and its limits.
     pub machine: Machine,
     /// Seed, repeats and curve settings.
@@ -67,10 +71,15 @@ pub fn run_bench(opts: &BenchOptions, log: &mut dyn FnMut(&str)) -> Result<Bench
     if opts.repeats == 0 {
         return Err(Error::InvalidOption("repeats must be at least 1".into()));
     }
-    if !(opts.curve_strain.is_finite() && opts.tresca_bound.is_finite() && opts.tresca_bound >= 0.0)
+    if !(opts.curve_strain.is_finite()
+        && opts.tresca_bound.is_finite()
+        && opts.tresca_bound >= 0.0
+        && opts
+            .curve_time_limit
+            .is_none_or(|s| s.is_finite() && s > 0.0))
     {
         return Err(Error::InvalidOption(
-            "curve strain and Tresca bound must be finite, the bound ≥ 0".into(),
+            "curve strain, Tresca bound and curve time limit must be finite, the bound ≥ 0, the limit > 0".into(),
         ));
     }
     for c in &opts.cells {
@@ -83,7 +92,7 @@ pub fn run_bench(opts: &BenchOptions, log: &mut dyn FnMut(&str)) -> Result<Bench
         cells.push(bench_cell(c, opts, &machine, log)?);
     }
     Ok(BenchReport {
-        version: env!("CARGO_PKG_VERSION"),
+        version: env!("CARGO_PKG_VERSION").to_string(),
         machine,
         seed: opts.seed,
         repeats: opts.repeats,

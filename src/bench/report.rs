@@ -95,6 +95,13 @@ pub fn markdown(r: &BenchReport) -> String {
     row("curve: increments, total", &|c| {
         c.curve.as_ref().map_or("–".into(), |k| match &k.error {
             Some(e) => format!("failed: {e}"),
+            None if k.completed < k.steps => format!(
+                "{} of {} in {} (time limit), projected {}",
+                k.completed,
+                k.steps,
+                ms(k.total),
+                ms(k.projected_total)
+            ),
             None => format!("{}, {}", k.steps, ms(k.total)),
         })
     });
@@ -164,4 +171,21 @@ pub fn markdown(r: &BenchReport) -> String {
         }
     }
     s
+}
+
+/// The marker lines between which [`splice_readme`] puts the tables.
+pub const README_MARKERS: [&str; 2] = ["<!-- bench:start -->", "<!-- bench:end -->"];
+
+/// Replaces the text between the two [`README_MARKERS`] lines of `readme` by `tables` and the
+/// command that reproduces them; None when the markers are missing or out of order.
+pub fn splice_readme(readme: &str, tables: &str, command: &str) -> Option<String> {
+    let start = readme.find(README_MARKERS[0])?;
+    let body = start + README_MARKERS[0].len();
+    let end = body + readme[body..].find(README_MARKERS[1])?;
+    Some(format!(
+        "{}\n\nReproduce: `{command}`\n\n{}\n{}",
+        &readme[..body],
+        tables.trim_end(),
+        &readme[end..]
+    ))
 }

@@ -53,7 +53,7 @@ pub struct Homogenized {
 }
 
 /// Wall-clock seconds of the stages of [`homogenize_elastic`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct HomogenizeTimings {
     /// Boundary pairing, contact search (with periodic images), percolation check and the
     /// sparsity pattern.

@@ -56,7 +56,8 @@ pub fn read_description(path: &Path) -> Result<ModelDescription, Error> {
     Ok(parse(&read_text(path)?, &shown)?)
 }
 
-fn read_text(path: &Path) -> Result<String, InputError> {
+/// Reads a whole text file; the error names it.
+pub fn read_text(path: &Path) -> Result<String, InputError> {
     std::fs::read_to_string(path).map_err(|e| InputError::Read {
         path: path.display().to_string(),
         message: e.to_string(),

@@ -79,6 +79,9 @@ pub struct IncrementalOptions {
     /// factorization add up to about its cost); fall back to a factorization when CG does not reach
     /// a backward error 1000 times below the accepted one (default true).
     pub reuse_factor: bool,
+    /// Stop after the increment during which this instant passes (default: none); the solution
+    /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Default for IncrementalOptions {
@@ -93,6 +96,7 @@ impl Default for IncrementalOptions {
             stabilization: 0.0,
             bonded: false,
             reuse_factor: true,
+            deadline: None,
         }
     }
 }
@@ -567,6 +571,7 @@ pub(crate) fn run_incremental(
                 set.clone(),
                 &IncrementalOptions {
                     fixed_slip_direction: false,
+                    deadline: None,
                     ..opts.clone()
                 },
             )?;
@@ -982,6 +987,12 @@ pub(crate) fn run_incremental(
         out.reactions = reactions;
         if let Some(p) = &opts.progress {
             (p.0)(step, path.len());
+        }
+        if opts
+            .deadline
+            .is_some_and(|d| std::time::Instant::now() >= d)
+        {
+            break;
         }
     }
     Ok(out)
