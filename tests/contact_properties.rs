@@ -119,6 +119,26 @@ proptest! {
         prop_assert!(kt0.amax() == 0.0 && ft.amax() > 0.0, "Tresca slip is a load only");
     }
 
+    /// The fill's closed-contact block Bᵀ S B + p_R RᵀR equals K_N + K_T^st + K_R (stick) and
+    /// K_N + K_R (sliding) built from the outer products, to rounding.
+    #[test]
+    fn the_closed_contact_block_is_the_sum_of_its_parts(
+        a in point(), b in point(), c in point(), d in point(),
+        xi in prop::array::uniform2(0.0f64..1.0), normal in unit(),
+    ) {
+        prop_assume!((Vector3::from(b) - Vector3::from(a)).norm() > 0.1 && (Vector3::from(d) - Vector3::from(c)).norm() > 0.1);
+        let model = Model::from_description(&fibers(&[(a, b, 0.01), (c, d, 0.01)], 2)).unwrap();
+        let pair = pair_from(&model, xi, normal);
+        let (kn, _) = pair.normal();
+        let (kt, _) = pair.stick(&Vector2::zeros());
+        for (stick, sum) in [(true, kn + kt + pair.rotation()), (false, kn + pair.rotation())] {
+            let k = pair.closed_stiffness(stick);
+            let expected = block(&pair, &sum);
+            let got = DMatrix::from_fn(pair.size(), pair.size(), &k);
+            prop_assert!((&got - &expected).amax() <= 1e-12 * expected.amax(), "stick {stick}");
+        }
+    }
+
     #[test]
     fn grid_search_finds_exactly_the_all_pairs_candidates(
         lines in prop::collection::vec((point(), point(), 0.005f64..0.05), 2..12),

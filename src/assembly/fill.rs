@@ -1,6 +1,6 @@
 //! Value fill of the reduced stiffness through the slot map, serial or parallel.
 
-use super::{color_elements, Pattern, NO_SLOT};
+use super::{color_elements, Pattern, SharedMut, NO_SLOT};
 use crate::element::{global_stiffness, FrameStiffness, Matrix12};
 use crate::model::{Fiber, Model};
 use fibercell_solver::SolverError;
@@ -41,11 +41,6 @@ pub fn element_stiffness(model: &Model, e: usize) -> Matrix12 {
 pub struct Assembler {
     colors: Vec<Vec<usize>>,
 }
-
-struct SharedValues(*mut f64);
-// SAFETY: used only for writes to disjoint slots (see `fill`).
-unsafe impl Sync for SharedValues {}
-unsafe impl Send for SharedValues {}
 
 fn scatter(k: &Matrix12, slots: &[u32], mut add: impl FnMut(usize, f64)) {
     for r in 0..12 {
@@ -96,16 +91,15 @@ impl Assembler {
                 }
             }
             FillMode::Parallel => {
-                let shared = SharedValues(values.as_mut_ptr());
+                let shared = SharedMut::new(values);
                 for color in &self.colors {
                     color.par_iter().with_min_len(64).for_each(|&e| {
                         let k = element_stiffness(model, e);
-                        let base = &shared;
                         // SAFETY: every slot of element e lies in a column of one of its nodes;
                         // elements of one color share no node, so no two tasks touch the same
-                        // slot, and all slots are < nnz = values.len().
+                        // slot.
                         scatter(&k, pattern.element_slots(e), |s, v| unsafe {
-                            *base.0.add(s) += v;
+                            *shared.get(s) += v;
                         });
                     });
                 }

@@ -5,8 +5,10 @@ mod coloring;
 mod dof_map;
 mod fill;
 mod pattern;
+mod shared;
 
-pub use coloring::color_elements;
+pub use coloring::{color_blocks, color_elements};
 pub use dof_map::{block_starts, DofMap};
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
 pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};
+pub(crate) use shared::SharedMut;

@@ -152,6 +152,23 @@ impl ContactPair {
         self.jump.r * q * self.penalty_rotation
     }
 
+    /// K_N + K_R (4.53), plus K_T^st (4.58) when `stick`, entry (row, column) of the leading
+    /// [`ContactPair::size`] square block: Bᵀ S B + p_R RᵀR with the 3 × 3
+    /// S = p_N n nᵀ (+ p_T (t₁t₁ᵀ + t₂t₂ᵀ)), six products per entry and no 30 × 30 temporaries
+    /// (the value fill of closed contacts).
+    pub fn closed_stiffness(&self, stick: bool) -> impl Fn(usize, usize) -> f64 + Sync + '_ {
+        let n = &self.normal;
+        let mut s = n * n.transpose() * self.penalty_normal;
+        if stick {
+            for t in &self.tangents {
+                s += t * t.transpose() * self.penalty_tangent;
+            }
+        }
+        let sb = s * self.jump.b;
+        let (b, r, pr) = (&self.jump.b, &self.jump.r, self.penalty_rotation);
+        move |i, j| b.column(i).dot(&sb.column(j)) + pr * r.column(i).dot(&r.column(j))
+    }
+
     /// K_T^st and F_T of a stuck contact with accumulated slip `slip` (4.58).
     pub fn stick(&self, slip: &Vector2<f64>) -> (BlockMatrix, BlockVector) {
         let b1 = self.bt_e(&Vector2::new(1.0, 0.0));

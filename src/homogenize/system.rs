@@ -6,13 +6,13 @@
 //! (K_N + K_T^st, plus the rolling resistance K_R): the elastic moduli A^elas of thesis (5.5).
 //! Contacts are searched with the periodic images, so crossings on the boundary count.
 
-use crate::assembly::{element_stiffness, Pattern, NO_SLOT};
+use crate::assembly::{color_blocks, element_stiffness, Pattern, SharedMut, NO_SLOT};
 use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain, Periodicity};
 use crate::constraints::Discretization;
-use crate::contact::{BlockMatrix, ContactPair, ContactSet, ContactSide};
+use crate::contact::{ContactPair, ContactSet, ContactSide};
 use crate::model::{Dof, Model};
 use crate::Error;
-use nalgebra::{DMatrix, SMatrix, Vector2};
+use nalgebra::{DMatrix, SMatrix};
 use rayon::prelude::*;
 
 /// The assembled values of a periodic cell problem.
@@ -26,8 +26,58 @@ pub struct PeriodicValues {
     pub k_ee: SMatrix<f64, 6, 6>,
 }
 
-/// Elements or contacts whose matrices are computed in parallel before being scattered.
-const CHUNK: usize = 4096;
+type Matrix6 = SMatrix<f64, 6, 6>;
+
+/// Where the blocks of one color write: K_ff through the pattern, K_fE by free DOF; blocks of
+/// a color share no generalized node but the driver, so their writes are disjoint.
+struct Sink<'a> {
+    disc: &'a Discretization,
+    driver: usize,
+    values: SharedMut<'a, f64>,
+    coupling: SharedMut<'a, [f64; 6]>,
+}
+
+impl Sink<'_> {
+    /// Adds the m × m block `k(row, column)` on generalized nodes `gnodes` (m = 6 per node)
+    /// through its row-major pattern `slots`; returns its driver–driver part, if any.
+    fn add(
+        &self,
+        gnodes: &[usize],
+        k: impl Fn(usize, usize) -> f64,
+        slots: &[u32],
+    ) -> Option<Matrix6> {
+        let m = 6 * gnodes.len();
+        let mut k_ee: Option<Matrix6> = None;
+        for r in 0..m {
+            let driver_r = gnodes[r / 6] == self.driver;
+            let free_r = self.disc.reduced(6 * gnodes[r / 6] + r % 6);
+            for c in 0..m {
+                let driver_c = gnodes[c / 6] == self.driver;
+                match (driver_r, driver_c) {
+                    (true, true) => {
+                        k_ee.get_or_insert_with(Matrix6::zeros)[(r % 6, c % 6)] += k(r, c)
+                    }
+                    (false, true) => {
+                        if let Some(i) = free_r {
+                            // SAFETY: row r's node is not the driver and belongs to this block
+                            // only within its color (see `PeriodicSystem::element_colors`).
+                            unsafe { self.coupling.get(i)[c % 6] += k(r, c) };
+                        }
+                    }
+                    (_, false) => {
+                        let s = slots[r * m + c];
+                        if s != NO_SLOT {
+                            // SAFETY: the slot couples two non-driver nodes of this block,
+                            // which no other block of its color holds.
+                            unsafe { *self.values.get(s as usize) += k(r, c) };
+                        }
+                    }
+                }
+            }
+        }
+        k_ee
+    }
+}
 
 /// The tangential state a closed contact enters the cell matrix with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,6 +111,10 @@ pub struct PeriodicSystem {
     /// Per element: its generalized nodes and T, None when T = I on its own nodes.
     elements: Vec<Option<(Vec<usize>, DMatrix<f64>)>>,
     contacts: Vec<ContactPair>,
+    /// Elements by color: no two of a color share a generalized node other than the driver.
+    element_colors: Vec<Vec<usize>>,
+    /// Closed contacts by color, likewise.
+    contact_colors: Vec<Vec<usize>>,
     /// The node whose translations are fixed.
     pub anchor: usize,
     /// How long building it took.
@@ -140,6 +194,16 @@ impl PeriodicSystem {
             .map(|(b, e)| b.as_ref().map_or(&e.nodes[..], |(g, _)| &g[..]))
             .chain(contacts.iter().map(|c| &c.jump.nodes[..]))
             .collect();
+        let driver = discretization.driver();
+        let n_gnodes = blocks
+            .iter()
+            .flat_map(|b| b.iter())
+            .max()
+            .map_or(0, |&n| n + 1);
+        let element_colors =
+            color_blocks(n_gnodes, blocks[..elements.len()].iter().copied(), driver);
+        let contact_colors =
+            color_blocks(n_gnodes, blocks[elements.len()..].iter().copied(), driver);
         timings.blocks = clock.elapsed().as_secs_f64();
         let clock = std::time::Instant::now();
         let pattern = Pattern::from_blocks(
@@ -155,6 +219,8 @@ impl PeriodicSystem {
             pattern,
             elements,
             contacts,
+            element_colors,
+            contact_colors,
             anchor,
             timings,
         })
@@ -192,95 +258,59 @@ impl PeriodicSystem {
         }
     }
 
-    /// Adds Tᵀ K T of every element. Element matrices are computed in parallel, a chunk at a
-    /// time, and scattered serially (the sums do not depend on the number of threads).
+    /// Adds Tᵀ K T of every element: the colors one after another, the elements of a color in
+    /// parallel, each writing its own entries (the sums do not depend on the number of threads).
     pub fn add_elements(&self, model: &Model, out: &mut PeriodicValues) {
         let els = model.elements();
-        for start in (0..els.len()).step_by(CHUNK) {
-            let end = (start + CHUNK).min(els.len());
-            let mats: Vec<DMatrix<f64>> = (start..end)
-                .into_par_iter()
-                .map(|e| {
-                    let k = element_stiffness(model, e);
-                    match &self.elements[e] {
-                        None => DMatrix::from_fn(12, 12, |r, c| k[(r, c)]),
-                        Some((_, t)) => {
-                            t.transpose() * DMatrix::from_fn(12, 12, |r, c| k[(r, c)]) * t
-                        }
-                    }
-                })
-                .collect();
-            for (e, k) in (start..end).zip(&mats) {
-                let gnodes = self.elements[e]
-                    .as_ref()
-                    .map_or(&els[e].nodes[..], |(g, _)| &g[..]);
-                self.scatter(out, gnodes, k.as_slice(), self.pattern.element_slots(e));
+        self.add_colored(out, &self.element_colors, |e, sink| {
+            let k = element_stiffness(model, e);
+            let slots = self.pattern.element_slots(e);
+            match &self.elements[e] {
+                None => sink.add(&els[e].nodes, |r, c| k[(r, c)], slots),
+                Some((g, t)) => {
+                    let tkt = t.transpose() * DMatrix::from_fn(12, 12, |r, c| k[(r, c)]) * t;
+                    sink.add(g, |r, c| tkt[(r, c)], slots)
+                }
             }
-        }
+        });
     }
 
-    /// Adds the closed contacts, contact i with the stiffness `which(i)`; in parallel chunks as
-    /// [`PeriodicSystem::add_elements`].
+    /// Adds the closed contacts, contact i with the stiffness `which(i)`; colored and parallel
+    /// as [`PeriodicSystem::add_elements`].
     pub fn add_contacts(
         &self,
         out: &mut PeriodicValues,
         which: impl Fn(usize) -> ContactStiffness + Sync,
     ) {
-        for start in (0..self.contacts.len()).step_by(CHUNK) {
-            let end = (start + CHUNK).min(self.contacts.len());
-            let mats: Vec<BlockMatrix> = (start..end)
-                .into_par_iter()
-                .map(|i| {
-                    let pair = &self.contacts[i];
-                    let (kn, _) = pair.normal();
-                    let kr = pair.rotation();
-                    match which(i) {
-                        ContactStiffness::Stick => {
-                            let (kt, _) = pair.stick(&Vector2::zeros());
-                            kn + kt + kr
-                        }
-                        ContactStiffness::Sliding => kn + kr,
-                    }
-                })
-                .collect();
-            for (i, k) in (start..end).zip(&mats) {
-                let pair = &self.contacts[i];
-                let m = pair.size();
-                // The leading m × m block of the fixed 30 × 30 matrix, column-major.
-                let block: Vec<f64> = (0..m)
-                    .flat_map(|c| (0..m).map(move |r| k[(r, c)]))
-                    .collect();
-                self.scatter(out, &pair.jump.nodes, &block, self.pattern.extra_slots(i));
-            }
-        }
+        self.add_colored(out, &self.contact_colors, |i, sink| {
+            let pair = &self.contacts[i];
+            let k = pair.closed_stiffness(which(i) == ContactStiffness::Stick);
+            sink.add(&pair.jump.nodes, k, self.pattern.extra_slots(i))
+        });
     }
 
-    /// Adds the column-major m × m block `k` on generalized nodes `gnodes` (m = 6 per node)
-    /// through its pattern `slots`.
-    fn scatter(&self, out: &mut PeriodicValues, gnodes: &[usize], k: &[f64], slots: &[u32]) {
-        let disc = &self.discretization;
-        let driver = disc.driver().unwrap_or(usize::MAX);
-        let m = 6 * gnodes.len();
-        let gdof = |r: usize| 6 * gnodes[r / 6] + r % 6;
-        for r in 0..m {
-            let driver_r = gnodes[r / 6] == driver;
-            for c in 0..m {
-                let v = k[c * m + r];
-                let driver_c = gnodes[c / 6] == driver;
-                match (driver_r, driver_c) {
-                    (true, true) => out.k_ee[(r % 6, c % 6)] += v,
-                    (false, true) => {
-                        if let Some(i) = disc.reduced(gdof(r)) {
-                            out.coupling[i][c % 6] += v;
-                        }
-                    }
-                    (_, false) => {
-                        let s = slots[r * m + c];
-                        if s != NO_SLOT {
-                            out.values[s as usize] += v;
-                        }
-                    }
-                }
+    /// Runs `block(i, sink)` for the blocks of each color in parallel, colors in order; the
+    /// driver–driver parts they return are summed in block order.
+    fn add_colored(
+        &self,
+        out: &mut PeriodicValues,
+        colors: &[Vec<usize>],
+        block: impl Fn(usize, &Sink<'_>) -> Option<Matrix6> + Sync,
+    ) {
+        let sink = Sink {
+            disc: &self.discretization,
+            driver: self.discretization.driver().unwrap_or(usize::MAX),
+            values: SharedMut::new(&mut out.values),
+            coupling: SharedMut::new(&mut out.coupling),
+        };
+        for color in colors {
+            let driver_blocks: Vec<Option<Matrix6>> = color
+                .par_iter()
+                .with_min_len(32)
+                .map(|&i| block(i, &sink))
+                .collect();
+            for m in driver_blocks.into_iter().flatten() {
+                out.k_ee += m;
             }
         }
     }
