@@ -2,8 +2,11 @@
 //! fixtures`): each parameter file regenerates exactly the committed cell, and the cell still
 //! gives its committed reference results — a regression check of the generators, the contact
 //! search and the homogenization together (their physics is validated against closed forms in
-//! the other tests). Counts must match exactly; lengths to 1e-12; the ABD to 1e-8 of each
-//! block's scale (the solver's roundoff on these cells is far below that).
+//! the other tests). Counts must match exactly; lengths to 1e-12; the ABD to 1e-5 of each
+//! block's scale √(A_ii A_jj): loosely held fibers make K of the non-woven cells ill-conditioned,
+//! so roundoff alone moves their bending blocks: in D16 of `nonwoven_medium`, faer and CHOLMOD on
+//! the same matrix differ by 1.2e-7 of the scale, and summing the entries of K in another order
+//! (the colored parallel fill against the earlier serial one) moves it by 1.2e-6.
 
 use fibercell::generate::{reference_results, CellParams, ReferenceResults};
 use fibercell::io::read_description;
@@ -46,7 +49,7 @@ fn check(name: &str) {
         for c in 0..6 {
             let scale = (want.abd[r][r] * want.abd[c][c]).abs().sqrt();
             assert!(
-                (got.abd[r][c] - want.abd[r][c]).abs() <= 1e-8 * scale,
+                (got.abd[r][c] - want.abd[r][c]).abs() <= 1e-5 * scale,
                 "{name}: ABD[{r}][{c}] = {:e}, reference {:e}",
                 got.abd[r][c],
                 want.abd[r][c]

@@ -92,6 +92,16 @@ pub fn markdown(r: &BenchReport) -> String {
     row("six cell problems (+ Θ), end to end", &|c| {
         ms(c.six_cell_problems)
     });
+    row(
+        "… setup / fill / analyze / factorize / Θ load / 7 solves",
+        &|c| {
+            c.six_cell_problem_stages.stages()[..6]
+                .iter()
+                .map(|&t| ms(t))
+                .collect::<Vec<_>>()
+                .join(" / ")
+        },
+    );
     row("curve: increments, total", &|c| {
         c.curve.as_ref().map_or("–".into(), |k| match &k.error {
             Some(e) => format!("failed: {e}"),

@@ -74,6 +74,22 @@ pub struct HomogenizeTimings {
     pub total: f64,
 }
 
+impl HomogenizeTimings {
+    /// The stages in order: setup, assembly, analysis, factorization, pressure load, solve,
+    /// post-processing (laps of one clock, adding up to at most `total`).
+    pub fn stages(&self) -> [f64; 7] {
+        [
+            self.setup,
+            self.assembly,
+            self.analysis,
+            self.factorization,
+            self.pressure_load,
+            self.solve,
+            self.post,
+        ]
+    }
+}
+
 /// The response of the cell to a unit out-of-plane pressure (1 Pa pushing the top face down,
 /// balanced by a uniform body force, zero macroscopic strain).
 #[derive(Clone, Debug, PartialEq, Serialize)]

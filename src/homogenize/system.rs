@@ -48,31 +48,29 @@ impl Sink<'_> {
     ) -> Option<Matrix6> {
         let m = 6 * gnodes.len();
         let mut k_ee: Option<Matrix6> = None;
-        for r in 0..m {
-            let driver_r = gnodes[r / 6] == self.driver;
-            let free_r = self.disc.reduced(6 * gnodes[r / 6] + r % 6);
-            for c in 0..m {
-                let driver_c = gnodes[c / 6] == self.driver;
-                match (driver_r, driver_c) {
-                    (true, true) => {
-                        k_ee.get_or_insert_with(Matrix6::zeros)[(r % 6, c % 6)] += k(r, c)
-                    }
-                    (false, true) => {
-                        if let Some(i) = free_r {
-                            // SAFETY: row r's node is not the driver and belongs to this block
-                            // only within its color (see `PeriodicSystem::element_colors`).
-                            unsafe { self.coupling.get(i)[c % 6] += k(r, c) };
-                        }
-                    }
-                    (_, false) => {
-                        let s = slots[r * m + c];
-                        if s != NO_SLOT {
-                            // SAFETY: the slot couples two non-driver nodes of this block,
-                            // which no other block of its color holds.
-                            unsafe { *self.values.get(s as usize) += k(r, c) };
-                        }
-                    }
+        let driver = |r: usize| gnodes[r / 6] == self.driver;
+        let mut put = |r: usize, c: usize, v: f64| match (driver(r), driver(c)) {
+            (true, true) => k_ee.get_or_insert_with(Matrix6::zeros)[(r % 6, c % 6)] += v,
+            (false, true) => {
+                if let Some(i) = self.disc.reduced(6 * gnodes[r / 6] + r % 6) {
+                    // SAFETY: row r's node is not the driver and belongs to this block only
+                    // within its color (see `PeriodicSystem::element_colors`).
+                    unsafe { self.coupling.get(i)[c % 6] += v };
                 }
+            }
+            (_, false) => {
+                let s = slots[r * m + c];
+                if s != NO_SLOT {
+                    // SAFETY: the slot couples two non-driver nodes of this block, which no
+                    // other block of its color holds.
+                    unsafe { *self.values.get(s as usize) += v };
+                }
+            }
+        };
+        // Column by column: a column's entries of one node are adjacent in K.
+        for c in 0..m {
+            for r in 0..m {
+                put(r, c, k(r, c));
             }
         }
         k_ee
@@ -202,8 +200,12 @@ impl PeriodicSystem {
             .map_or(0, |&n| n + 1);
         let element_colors =
             color_blocks(n_gnodes, blocks[..elements.len()].iter().copied(), driver);
-        let contact_colors =
+        let mut contact_colors =
             color_blocks(n_gnodes, blocks[elements.len()..].iter().copied(), driver);
+        // Within a color, by first node: neighbouring contacts write neighbouring columns.
+        for color in &mut contact_colors {
+            color.sort_by_key(|&i| contacts[i].jump.nodes.iter().min().copied());
+        }
         timings.blocks = clock.elapsed().as_secs_f64();
         let clock = std::time::Instant::now();
         let pattern = Pattern::from_blocks(

@@ -17,7 +17,9 @@
 
 use super::static_solve::{backward_tolerance, check_backward_error, locate};
 use super::{check_supported_with, make_solver, SolveOptions, SolverKind};
-use crate::assembly::{element_stiffness, Assembler, DofMap, Pattern, NO_SLOT};
+use crate::assembly::{
+    color_blocks, element_stiffness, Assembler, DofMap, Pattern, SharedMut, NO_SLOT,
+};
 use crate::constraints::{internal_forces, Discretization, Reaction};
 use crate::contact::{
     BlockMatrix, BlockVector, ContactPair, ContactSet, ContactSide, ContactState, Friction,
@@ -74,10 +76,11 @@ pub struct IncrementalOptions {
     pub bonded: bool,
     /// After a few contacts changed state (at most 1 % of them; changes of slip directions and
     /// of the tangent across them do not count), solve by CG preconditioned with
-    /// the last symmetric factorization instead of refactorizing, within an iteration budget of
-    /// a tenth of a factorization's flops (refactorizing once the iterations spent on one
-    /// factorization add up to about its cost); fall back to a factorization when CG does not reach
-    /// a backward error 1000 times below the accepted one (default true).
+    /// the last symmetric factorization instead of refactorizing, within an iteration budget
+    /// worth half a factorization's measured time (a tenth of its flops until a factorization
+    /// and a CG iteration have been timed), refactorizing once ten budgets were spent on one
+    /// factorization; fall back to a factorization when CG does not reach a backward error 1000
+    /// times below the accepted one (default true).
     pub reuse_factor: bool,
     /// Stop after the increment during which this instant passes (default: none); the solution
     /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
@@ -368,6 +371,24 @@ fn reuse_iterations(info: &AnalyzeInfo) -> usize {
     }
 }
 
+/// What a factorization and one CG iteration on it cost, as measured in this run; the CG
+/// budget of a factor-reuse solve is half a factorization's time, or before both were measured
+/// the flops estimate of [`reuse_iterations`].
+struct ReuseCost {
+    estimate: usize,
+    factorize: Option<f64>,
+    per_iteration: Option<f64>,
+}
+
+impl ReuseCost {
+    fn budget(&self) -> usize {
+        match (self.factorize, self.per_iteration) {
+            (Some(f), Some(i)) if i > 0.0 => ((0.5 * f / i) as usize).min(500),
+            _ => self.estimate,
+        }
+    }
+}
+
 /// What an assembled matrix was built from: symmetry, states, slip directions, k⊥ of each contact.
 type AssembledKey = (bool, Vec<ContactState>, Vec<Vector2<f64>>, Vec<f64>);
 
@@ -604,6 +625,13 @@ pub(crate) fn run_incremental(
     )?;
     let mut k_elastic = vec![0.0; pattern.nnz()];
     elastic.fill(model, &pattern, &mut k_elastic, opts.solve.fill)?;
+    // Contacts by color: no two of a color share a generalized node (the driver, which has no
+    // rows, aside), so a color's contacts are scattered in parallel.
+    let contact_colors = color_blocks(
+        disc.n_gnodes(),
+        pairs.iter().map(|p| &p.jump.nodes[..]),
+        disc.driver(),
+    );
     let rhs_full = elastic.rhs(model, disc);
     let n_free = disc.n_free();
     let mut applied_full = [0.0; 6];
@@ -665,7 +693,11 @@ pub(crate) fn run_incremental(
     }
     let mut dissipated = 0.0;
     // CG iterations preconditioned by the previous factorization allowed per solve (0: none).
-    let mut reuse_budget = 0;
+    let mut reuse_cost = ReuseCost {
+        estimate: 0,
+        factorize: None,
+        per_iteration: None,
+    };
     // CG iterations spent on the current factorization: once they add up to about one
     // factorization, refactorize.
     let mut spent_since_factor = 0;
@@ -687,8 +719,8 @@ pub(crate) fn run_incremental(
                 .collect();
             let nonsymmetric = matches!(friction, Friction::Coulomb { mu } if mu > 0.0)
                 && states.contains(&ContactState::Slip);
-            // The contact blocks for the current states, computed in parallel chunks and
-            // scattered serially (sums independent of the number of threads).
+            // The contact blocks for the current states, computed and scattered in parallel
+            // color by color (sums independent of the number of threads).
             let block = |i: usize| -> Option<(BlockMatrix, BlockVector)> {
                 let pair = &pairs[i];
                 match states[i] {
@@ -724,31 +756,35 @@ pub(crate) fn run_incremental(
                     }
                 }
             };
-            const CHUNK: usize = 2048;
-            for start in (0..pairs.len()).step_by(CHUNK) {
-                let end = (start + CHUNK).min(pairs.len());
-                let blocks: Vec<Option<(BlockMatrix, BlockVector)>> =
-                    (start..end).into_par_iter().map(block).collect();
-                for (i, b) in (start..end).zip(blocks) {
-                    let Some((k, f)) = b else { continue };
-                    let pair = &pairs[i];
-                    let m = pair.size();
-                    let slots = pattern.extra_slots(i);
-                    let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
-                    for r in 0..m {
-                        let Some(ir) = disc.reduced(gdof(r)) else {
-                            continue;
-                        };
-                        rhs[ir] += f[r];
-                        for c in 0..m {
-                            let s = slots[r * m + c];
-                            if s != NO_SLOT {
-                                values[s as usize] += k[(r, c)];
-                            } else if disc.reduced(gdof(c)).is_none() {
-                                rhs[ir] -= k[(r, c)] * alpha * disc.prescribed_value(gdof(c));
+            {
+                let shared_values = SharedMut::new(&mut values);
+                let shared_rhs = SharedMut::new(&mut rhs);
+                for color in &contact_colors {
+                    color.par_iter().with_min_len(16).for_each(|&i| {
+                        let Some((k, f)) = block(i) else { return };
+                        let pair = &pairs[i];
+                        let m = pair.size();
+                        let slots = pattern.extra_slots(i);
+                        let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
+                        for r in 0..m {
+                            let Some(ir) = disc.reduced(gdof(r)) else {
+                                continue;
+                            };
+                            // SAFETY: row r is a free DOF of a node no other contact of this
+                            // color holds, and so are the slots of row r.
+                            let rhs_r = unsafe { shared_rhs.get(ir) };
+                            *rhs_r += f[r];
+                            for c in 0..m {
+                                let s = slots[r * m + c];
+                                if s != NO_SLOT {
+                                    // SAFETY: as above.
+                                    unsafe { *shared_values.get(s as usize) += k[(r, c)] };
+                                } else if disc.reduced(gdof(c)).is_none() {
+                                    *rhs_r -= k[(r, c)] * alpha * disc.prescribed_value(gdof(c));
+                                }
                             }
                         }
-                    }
+                    });
                 }
             }
             if disc.is_identity() {
@@ -764,7 +800,7 @@ pub(crate) fn run_incremental(
                 let mut s = make_solver(kind, &opts.solve.ordering, disc.node_block_starts())?;
                 let info = s.analyze(a).map_err(locate)?;
                 if !nonsymmetric && !s.capabilities().iterative {
-                    reuse_budget = reuse_iterations(&info);
+                    reuse_cost.estimate = reuse_iterations(&info);
                 }
                 *slot = Some(s);
             }
@@ -781,6 +817,7 @@ pub(crate) fn run_incremental(
             // when few contacts changed since it was computed (each change is a low-rank
             // update); otherwise, or when CG does not converge within its budget, refactorize.
             let mut reused = None;
+            let reuse_budget = reuse_cost.budget();
             if let Some(old) = factorized.as_ref().filter(|_| n_free > 0) {
                 if opts.reuse_factor
                     && !nonsymmetric
@@ -791,8 +828,13 @@ pub(crate) fn run_incremental(
                     && spent_since_factor < 10 * reuse_budget
                 {
                     let tol = 1e-3 * backward_tolerance(&opts.solve);
+                    let clock = std::time::Instant::now();
                     let r = pcg_with_factor(solver.as_mut(), a, &rhs, tol, reuse_budget)
                         .map_err(locate)?;
+                    if r.iterations > 0 {
+                        reuse_cost.per_iteration =
+                            Some(clock.elapsed().as_secs_f64() / r.iterations as f64);
+                    }
                     reuse_iterations_done += r.iterations;
                     spent_since_factor += r.iterations.max(1);
                     if r.converged {
@@ -814,7 +856,11 @@ pub(crate) fn run_incremental(
                 (r.x, Some(report))
             } else {
                 if factorized.as_ref() != Some(&key) {
+                    let clock = std::time::Instant::now();
                     solver.factorize(a).map_err(locate)?;
+                    if !nonsymmetric {
+                        reuse_cost.factorize = Some(clock.elapsed().as_secs_f64());
+                    }
                     factorizations += 1;
                     factorized = Some(key);
                     spent_since_factor = 0;
