@@ -95,4 +95,9 @@ fn the_readme_tables_are_spliced_between_the_markers_only() {
     assert_eq!(splice_readme("no markers", "x", "c"), None);
     let reversed = "<!-- bench:end -->\n<!-- bench:start -->\n";
     assert_eq!(splice_readme(reversed, "x", "c"), None);
+    // A marker quoted inside a sentence is not a marker line.
+    let quoted = format!("See `<!-- bench:start -->` below.\n{readme}");
+    let spliced = splice_readme(&quoted, "| a | b |\n", "fibercell bench").expect("markers");
+    assert!(spliced.starts_with("See `<!-- bench:start -->` below.\n# T\n"));
+    assert!(spliced.contains("<!-- bench:start -->\n\nReproduce"));
 }

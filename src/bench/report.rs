@@ -186,12 +186,23 @@ pub fn markdown(r: &BenchReport) -> String {
 /// The marker lines between which [`splice_readme`] puts the tables.
 pub const README_MARKERS: [&str; 2] = ["<!-- bench:start -->", "<!-- bench:end -->"];
 
-/// Replaces the text between the two [`README_MARKERS`] lines of `readme` by `tables` and the
-/// command that reproduces them; None when the markers are missing or out of order.
+/// Replaces the text between the two [`README_MARKERS`] lines of `readme` (each alone on its
+/// line; mentions inside other text do not count) by `tables` and the command that reproduces
+/// them; None when a marker line is missing or they are out of order.
 pub fn splice_readme(readme: &str, tables: &str, command: &str) -> Option<String> {
-    let start = readme.find(README_MARKERS[0])?;
+    let line_at = |marker: &str, from: usize| -> Option<usize> {
+        let mut pos = from;
+        for line in readme[from..].split_inclusive('\n') {
+            if line.trim_end() == marker {
+                return Some(pos);
+            }
+            pos += line.len();
+        }
+        None
+    };
+    let start = line_at(README_MARKERS[0], 0)?;
     let body = start + README_MARKERS[0].len();
-    let end = body + readme[body..].find(README_MARKERS[1])?;
+    let end = line_at(README_MARKERS[1], body)?;
     Some(format!(
         "{}\n\nReproduce: `{command}`\n\n{}\n{}",
         &readme[..body],
