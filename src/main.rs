@@ -410,9 +410,12 @@ fn bench(
             .iter()
             .find_map(|c| c.curve.as_ref())
             .map_or(0, |k| k.steps);
+        let limit = report
+            .curve_time_limit
+            .map_or(String::new(), |s| format!(" --curve-time-limit {s}"));
         let command = format!(
-            "cargo run --release{} -- bench --cells {} --repeats {} --seed {} --curve-steps {steps} \
-             --json bench.json --readme README.md",
+            "cargo run --release{} -- bench --cells {} --repeats {} --seed {} --curve-steps {steps}\
+             {limit} --json bench.json --readme README.md",
             if cholmod { " --features cholmod" } else { "" },
             cells.join(","),
             report.repeats,

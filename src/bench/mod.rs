@@ -62,6 +62,9 @@ pub struct BenchReport {
     pub seed: u64,
     /// Repeats per stage.
     pub repeats: usize,
+    /// The curve's wall-clock limit (s), if any.
+    #[serde(default)]
+    pub curve_time_limit: Option<f64>,
     /// One entry per cell.
     pub cells: Vec<CellBench>,
 }
@@ -96,6 +99,7 @@ pub fn run_bench(opts: &BenchOptions, log: &mut dyn FnMut(&str)) -> Result<Bench
         machine,
         seed: opts.seed,
         repeats: opts.repeats,
+        curve_time_limit: opts.curve_time_limit,
         cells,
     })
 }

@@ -17,8 +17,9 @@ pub enum Ordering {
     Natural,
     /// Approximate minimum degree.
     Amd,
-    /// Nested dissection through METIS `METIS_NodeND`, on the graph compressed to
-    /// supervariables (consecutive columns with identical patterns, e.g. the six DOFs of a node).
+    /// Nested dissection through METIS `METIS_NodeND` (the best of five separators at each
+    /// level), on the graph compressed to supervariables (consecutive columns with identical
+    /// patterns, e.g. the six DOFs of a node).
     NestedDissection,
     /// A caller's permutation: `perm[new] = old`.
     Given(Vec<usize>),
@@ -127,6 +128,9 @@ fn supervariables(a: CscRef<'_>) -> (Vec<usize>, Vec<usize>) {
     (group, starts)
 }
 
+/// METIS_OPTION_NSEPS of the nested dissection.
+const SEPARATORS_TRIED: metis_sys::idx_t = 5;
+
 fn nested_dissection(a: CscRef<'_>) -> Result<Permutation, SolverError> {
     let n = a.ncols();
     if n <= 1 {
@@ -166,6 +170,10 @@ fn nested_dissection(a: CscRef<'_>) -> Result<Permutation, SolverError> {
     let status = unsafe {
         metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr());
         options[metis_sys::moptions_et_METIS_OPTION_NUMBERING as usize] = 0;
+        // Five separators tried at each level, the smallest kept: on the non-woven cells nnz(L)
+        // drops 3-4 % below the single-separator default (M: 1.190e7 -> 1.134e7, L: 8.05e7 ->
+        // 7.74e7, below CHOLMOD's default ordering) for about twice the ordering time.
+        options[metis_sys::moptions_et_METIS_OPTION_NSEPS as usize] = SEPARATORS_TRIED;
         metis_sys::METIS_NodeND(
             &mut nvtxs,
             xadj.as_mut_ptr(),
