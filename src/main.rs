@@ -139,7 +139,7 @@ enum Command {
         #[arg(long, default_value_t = 100)]
         curve_steps: usize,
         /// Wall-clock limit of one curve in seconds: it stops there and the rest is projected.
-        #[arg(long, default_value_t = 1200.0)]
+        #[arg(long, default_value_t = fibercell::bench::DEFAULT_CURVE_TIME_LIMIT)]
         curve_time_limit: f64,
         /// Do not run: render the report of an earlier --json file.
         #[arg(long)]
@@ -399,28 +399,7 @@ fn bench(
     println!("{text}");
     if let Some(p) = readme {
         let old = io::read_text(p)?;
-        let cells: Vec<&str> = report.cells.iter().map(|c| c.cell.as_str()).collect();
-        let cholmod = report
-            .cells
-            .iter()
-            .flat_map(|c| &c.backends)
-            .any(|b| b.name.contains("cholmod"));
-        let steps = report
-            .cells
-            .iter()
-            .find_map(|c| c.curve.as_ref())
-            .map_or(0, |k| k.steps);
-        let limit = report
-            .curve_time_limit
-            .map_or(String::new(), |s| format!(" --curve-time-limit {s}"));
-        let command = format!(
-            "cargo run --release{} -- bench --cells {} --repeats {} --seed {} --curve-steps {steps}\
-             {limit} --json bench.json --readme README.md",
-            if cholmod { " --features cholmod" } else { "" },
-            cells.join(","),
-            report.repeats,
-            report.seed
-        );
+        let command = bench::reproduce_command(&report);
         let new = bench::splice_readme(&old, &text, &command).ok_or_else(|| {
             Error::InvalidOption(format!(
                 "{}: no {} … {} markers",

@@ -2,7 +2,7 @@
 //! and consistent with the others (same matrix for every backend, the factor-reuse solve
 //! converges after one switch, the curve runs), and bad options are typed errors.
 
-use fibercell::bench::{markdown, run_bench, splice_readme, BenchOptions};
+use fibercell::bench::{markdown, reproduce_command, run_bench, splice_readme, BenchOptions};
 use fibercell::Error;
 
 #[test]
@@ -56,6 +56,15 @@ fn the_small_cell_runs_every_stage() {
     let text = markdown(&r);
     assert!(text.contains("| six cell problems"));
     assert!(text.contains("1 of 2 in"), "{text}");
+    let command = reproduce_command(&r);
+    for part in [
+        "--cells S ",
+        "--repeats 1 ",
+        "--curve-steps 2 ",
+        "--curve-time-limit 0.000001 ",
+    ] {
+        assert!(command.contains(part), "{command}");
+    }
     assert!(log.iter().any(|l| l.contains("S: six cell problems")));
 }
 

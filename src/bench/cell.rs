@@ -18,6 +18,12 @@ use fibercell_solver::{pcg_with_factor, CscRef, Ordering};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
+/// Median of non-empty `times` (the upper one of an even count); 0 when empty.
+fn median(mut times: Vec<f64>) -> f64 {
+    times.sort_by(f64::total_cmp);
+    times.get(times.len() / 2).copied().unwrap_or(0.0)
+}
+
 /// Median of `repeats` timings of `f` (seconds), with the last result.
 fn median_of<T>(
     repeats: usize,
@@ -30,9 +36,8 @@ fn median_of<T>(
         last = Some(f()?);
         times.push(t.elapsed().as_secs_f64());
     }
-    times.sort_by(f64::total_cmp);
     let out = last.ok_or_else(|| Error::InvalidOption("no repeat ran".into()))?;
-    Ok((times[times.len() / 2], out))
+    Ok((median(times), out))
 }
 
 /// One backend on the cell-problem matrix.
@@ -337,16 +342,15 @@ fn bench_curve(
     match result {
         Ok(c) => {
             let inc = &c.solution.increments;
-            let mut secs: Vec<f64> = inc.iter().map(|r| r.seconds).collect();
+            let secs: Vec<f64> = inc.iter().map(|r| r.seconds).collect();
             let spent: f64 = secs.iter().sum();
             bench.completed = inc.len();
             if !inc.is_empty() {
                 bench.projected_total =
                     total - spent + spent / inc.len() as f64 * opts.curve_steps as f64;
             }
-            secs.sort_by(f64::total_cmp);
-            bench.increment_median = secs.get(secs.len() / 2).copied().unwrap_or(0.0);
-            bench.increment_max = secs.last().copied().unwrap_or(0.0);
+            bench.increment_max = secs.iter().copied().fold(0.0, f64::max);
+            bench.increment_median = median(secs);
             bench.state_iterations = inc.iter().map(|r| r.iterations).sum();
             bench.factorizations = inc.iter().map(|r| r.factorizations).sum();
             bench.factor_reuses = inc.iter().map(|r| r.factor_reuses).sum();
@@ -384,16 +388,16 @@ pub fn bench_cell(
     // Refills of one buffer, as in the incremental hot path; zeroing is not timed.
     let mut buffer = sys.zero_values();
     let mut refill = |add: &dyn Fn(&mut crate::homogenize::PeriodicValues)| {
-        let mut times: Vec<f64> = (0..opts.repeats.max(1))
-            .map(|_| {
-                buffer.values.fill(0.0);
-                let t = Instant::now();
-                add(&mut buffer);
-                t.elapsed().as_secs_f64()
-            })
-            .collect();
-        times.sort_by(f64::total_cmp);
-        times[times.len() / 2]
+        median(
+            (0..opts.repeats.max(1))
+                .map(|_| {
+                    buffer.values.fill(0.0);
+                    let t = Instant::now();
+                    add(&mut buffer);
+                    t.elapsed().as_secs_f64()
+                })
+                .collect(),
+        )
     };
     let fill_elements = refill(&|v| sys.add_elements(&model, v));
     let fill_contacts = refill(&|v| sys.add_contacts(v, |_| ContactStiffness::Stick));

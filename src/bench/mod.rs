@@ -11,10 +11,13 @@ mod report;
 
 pub use cell::{bench_cell, BackendBench, CellBench, CurveBench, ReuseBench};
 pub use machine::{dgemm_gflops, measure_machine, peak_memory_bytes, triad_bandwidth, Machine};
-pub use report::{markdown, splice_readme, README_MARKERS};
+pub use report::{markdown, reproduce_command, splice_readme, README_MARKERS, REPORT_PATH};
 
 use crate::Error;
 use serde::{Deserialize, Serialize};
+
+/// Default wall-clock limit of one curve (s).
+pub const DEFAULT_CURVE_TIME_LIMIT: f64 = 1200.0;
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -46,7 +49,7 @@ impl Default for BenchOptions {
             curve_steps: 100,
             curve_strain: 2e-3,
             tresca_bound: 1e-4,
-            curve_time_limit: Some(1200.0),
+            curve_time_limit: Some(DEFAULT_CURVE_TIME_LIMIT),
         }
     }
 }

@@ -183,6 +183,36 @@ pub fn markdown(r: &BenchReport) -> String {
     s
 }
 
+/// Where `fibercell bench --readme` expects the report to be committed.
+pub const REPORT_PATH: &str = "benches/results/bench.json";
+
+/// The `fibercell bench` command that measures `r` again (cells, repeats, seed, curve steps and
+/// time limit, the CHOLMOD feature when a CHOLMOD backend ran).
+pub fn reproduce_command(r: &BenchReport) -> String {
+    let cells: Vec<&str> = r.cells.iter().map(|c| c.cell.as_str()).collect();
+    let cholmod = r
+        .cells
+        .iter()
+        .flat_map(|c| &c.backends)
+        .any(|b| b.name.contains("cholmod"));
+    let steps = r
+        .cells
+        .iter()
+        .find_map(|c| c.curve.as_ref())
+        .map_or(0, |k| k.steps);
+    let limit = r
+        .curve_time_limit
+        .map_or(String::new(), |s| format!(" --curve-time-limit {s}"));
+    format!(
+        "cargo run --release{} -- bench --cells {} --repeats {} --seed {} --curve-steps {steps}\
+         {limit} --json {REPORT_PATH} --readme README.md",
+        if cholmod { " --features cholmod" } else { "" },
+        cells.join(","),
+        r.repeats,
+        r.seed
+    )
+}
+
 /// The marker lines between which [`splice_readme`] puts the tables.
 pub const README_MARKERS: [&str; 2] = ["<!-- bench:start -->", "<!-- bench:end -->"];
 

@@ -192,12 +192,7 @@ impl PeriodicSystem {
             .map(|(b, e)| b.as_ref().map_or(&e.nodes[..], |(g, _)| &g[..]))
             .chain(contacts.iter().map(|c| &c.jump.nodes[..]))
             .collect();
-        let driver = discretization.driver();
-        let n_gnodes = blocks
-            .iter()
-            .flat_map(|b| b.iter())
-            .max()
-            .map_or(0, |&n| n + 1);
+        let (driver, n_gnodes) = (discretization.driver(), discretization.n_gnodes());
         let element_colors =
             color_blocks(n_gnodes, blocks[..elements.len()].iter().copied(), driver);
         let mut contact_colors =
