@@ -120,7 +120,8 @@ proptest! {
     }
 
     /// The fill's closed-contact block Bᵀ S B + p_R RᵀR equals K_N + K_T^st + K_R (stick) and
-    /// K_N + K_R (sliding) built from the outer products, to rounding.
+    /// K_N + K_R (sliding) built from the outer products, and its stick load F_N + F_T, to
+    /// rounding.
     #[test]
     fn the_closed_contact_block_is_the_sum_of_its_parts(
         a in point(), b in point(), c in point(), d in point(),
@@ -129,8 +130,12 @@ proptest! {
         prop_assume!((Vector3::from(b) - Vector3::from(a)).norm() > 0.1 && (Vector3::from(d) - Vector3::from(c)).norm() > 0.1);
         let model = Model::from_description(&fibers(&[(a, b, 0.01), (c, d, 0.01)], 2)).unwrap();
         let pair = pair_from(&model, xi, normal);
-        let (kn, _) = pair.normal();
+        let (kn, fn_) = pair.normal();
         let (kt, _) = pair.stick(&Vector2::zeros());
+        let slip = Vector2::new(xi[0] - 0.5, 0.25 - xi[1]);
+        let expected_load = fn_ + pair.stick(&slip).1;
+        let load = pair.stick_load(&slip);
+        prop_assert!((load - expected_load).amax() <= 1e-12 * expected_load.amax().max(1e-300));
         for (stick, sum) in [(true, kn + kt + pair.rotation()), (false, kn + pair.rotation())] {
             let k = pair.closed_stiffness(stick);
             let expected = block(&pair, &sum);

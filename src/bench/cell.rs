@@ -114,6 +114,11 @@ pub struct CurveBench {
     pub sliding_at_end: usize,
     /// Contacts held after chattering (summed over increments).
     pub held: usize,
+    /// Seconds of the completed increments per stage: assemble, factorize, factor reuse,
+    /// solve, classify, commit ([`crate::solve::IncrementTimings::NAMES`]); absent in reports
+    /// written before it was measured.
+    #[serde(default)]
+    pub stages: Option<[f64; 6]>,
     /// The error, when the curve failed.
     pub error: Option<String>,
 }
@@ -337,6 +342,7 @@ fn bench_curve(
         factor_reuses: 0,
         sliding_at_end: 0,
         held: 0,
+        stages: None,
         error: None,
     };
     match result {
@@ -355,6 +361,9 @@ fn bench_curve(
             bench.factorizations = inc.iter().map(|r| r.factorizations).sum();
             bench.factor_reuses = inc.iter().map(|r| r.factor_reuses).sum();
             bench.held = inc.iter().map(|r| r.held).sum();
+            let mut stages = crate::solve::IncrementTimings::default();
+            inc.iter().for_each(|r| stages.add(&r.timings));
+            bench.stages = Some(stages.stages());
             bench.sliding_at_end = inc.last().map_or(0, |r| r.slip);
         }
         Err(e) => bench.error = Some(e.to_string()),

@@ -120,11 +120,28 @@ pub fn markdown(r: &BenchReport) -> String {
             format!("{} / {}", ms(k.increment_median), ms(k.increment_max))
         })
     });
-    row("curve: factorizations / factor reuses", &|c| {
-        c.curve.as_ref().map_or("–".into(), |k| {
-            format!("{} / {}", k.factorizations, k.factor_reuses)
-        })
-    });
+    row(
+        "curve: state iterations / factorizations / factor reuses",
+        &|c| {
+            c.curve.as_ref().map_or("–".into(), |k| {
+                format!(
+                    "{} / {} / {}",
+                    k.state_iterations, k.factorizations, k.factor_reuses
+                )
+            })
+        },
+    );
+    row(
+        "… assemble / factorize / factor reuse / solve / classify / commit",
+        &|c| {
+            c.curve
+                .as_ref()
+                .and_then(|k| k.stages)
+                .map_or("–".into(), |s| {
+                    s.iter().map(|&t| ms(t)).collect::<Vec<_>>().join(" / ")
+                })
+        },
+    );
     row("curve: sliding at end / held", &|c| {
         c.curve.as_ref().map_or("–".into(), |k| {
             format!("{} / {}", k.sliding_at_end, k.held)

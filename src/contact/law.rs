@@ -169,6 +169,15 @@ impl ContactPair {
         move |i, j| b.column(i).dot(&sb.column(j)) + pr * r.column(i).dot(&r.column(j))
     }
 
+    /// F_N + F_T of a stuck contact with accumulated slip `slip` (4.53, 4.58), the load that
+    /// goes with [`ContactPair::closed_stiffness`]`(true)`: Bᵀ (p_N ḡ n + p_T E s), with no
+    /// 30 × 30 temporaries.
+    pub fn stick_load(&self, slip: &Vector2<f64>) -> BlockVector {
+        let jump_force = self.normal * (self.penalty_normal * self.gap)
+            + (self.tangents[0] * slip[0] + self.tangents[1] * slip[1]) * self.penalty_tangent;
+        self.jump.b.transpose() * jump_force
+    }
+
     /// K_T^st and F_T of a stuck contact with accumulated slip `slip` (4.58).
     pub fn stick(&self, slip: &Vector2<f64>) -> (BlockMatrix, BlockVector) {
         let b1 = self.bt_e(&Vector2::new(1.0, 0.0));

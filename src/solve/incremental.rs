@@ -16,7 +16,7 @@
 //! backend.
 
 use super::static_solve::{backward_tolerance, check_backward_error, locate};
-use super::{check_supported_with, make_solver, SolveOptions, SolverKind};
+use super::{check_supported_with, make_solver, IncrementTimings, SolveOptions, SolverKind};
 use crate::assembly::{
     color_blocks, element_stiffness, Assembler, DofMap, Pattern, SharedMut, NO_SLOT,
 };
@@ -74,13 +74,13 @@ pub struct IncrementalOptions {
     /// evolve, with a Coulomb bound μ max(N, 0). A model of bonded or consolidated mats, whose
     /// just-touching contacts would otherwise open under the smallest strain and chatter.
     pub bonded: bool,
-    /// After a few contacts changed state (at most 1 % of them; changes of slip directions and
-    /// of the tangent across them do not count), solve by CG preconditioned with
+    /// After the blocks of a few contacts changed (at most 1 % of them: a state, a slip
+    /// direction or the tangent across it), solve by CG preconditioned with
     /// the last symmetric factorization instead of refactorizing, within an iteration budget
     /// worth half a factorization's measured time (a tenth of its flops until a factorization
     /// and a CG iteration have been timed), refactorizing once ten budgets were spent on one
-    /// factorization; fall back to a factorization when CG does not reach a backward error 1000
-    /// times below the accepted one (default true).
+    /// factorization; fall back to a factorization when CG does not reach a backward error 10⁵
+    /// times below the accepted one, as accurate as a direct solve (default true).
     pub reuse_factor: bool,
     /// Stop after the increment during which this instant passes (default: none); the solution
     /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
@@ -144,6 +144,9 @@ pub struct IncrementRecord {
     /// Wall-clock seconds of the increment (not serialized: results files stay reproducible).
     #[serde(skip)]
     pub seconds: f64,
+    /// Those seconds per stage (not serialized).
+    #[serde(skip)]
+    pub timings: IncrementTimings,
     /// Backward error of the last solve.
     pub backward_error: f64,
 }
@@ -209,6 +212,19 @@ struct Law {
 
 /// State switches of one contact within an increment after which it is held in its state.
 const CHATTER_SWITCHES: usize = 4;
+
+/// A sliding contact's direction has converged when the change |Δd| times its slip |u_t − s|
+/// (the tangential displacement across the old direction the change stands for) is below this
+/// fraction of the model size. Newton's iteration on the directions converges quadratically
+/// down to roundoff: on the benchmark's S cell |Δd|·|u_t − s| falls from 1e-12 to 1e-16 of the
+/// size and then stays there, so 1e-10 ends the iteration one step after the directions settle.
+const SLIP_DIRECTION_TOLERANCE: f64 = 1e-10;
+
+/// The backward error a factor-reuse CG solve must reach, relative to the accepted one of a
+/// direct solve. The slip directions are read off the last digits of the tangential
+/// displacements, so a CG solve must be as accurate as a direct one: at 1e-3 the directions of
+/// barely sliding contacts wandered by 1e-3 between iterations (measured on the S cell).
+const REUSE_ACCURACY: f64 = 1e-5;
 
 /// The trial `t` of a contact held in `state` with slip direction `direction` (a contact that
 /// chattered): forces consistent with that state (stick: the trial force; slip: the bound along
@@ -353,10 +369,14 @@ fn stabilizer(pair: &ContactPair, state: ContactState) -> BlockMatrix {
     }
 }
 
-/// Contacts whose state (open, stick, slip) differs between two assembled keys. Changes of a
-/// slip direction or of k⊥ alone are small perturbations, left to the iteration budget.
-fn differing_states(a: &AssembledKey, b: &AssembledKey) -> usize {
-    (0..a.1.len()).filter(|&i| a.1[i] != b.1[i]).count()
+/// Contacts whose block differs between two assembled keys: a state (open, stick, slip), a
+/// slip direction or the tangent k⊥ across it. Each is a change of rank up to 3 that CG on the
+/// old factor needs iterations for; after a new increment every sliding contact's direction
+/// moved, and CG on hundreds of them fails its budget (measured on the M cell).
+fn differing_blocks(a: &AssembledKey, b: &AssembledKey) -> usize {
+    (0..a.1.len())
+        .filter(|&i| a.1[i] != b.1[i] || a.2[i] != b.2[i] || a.3[i] != b.3[i])
+        .count()
 }
 
 /// CG iterations preconditioned by a factorization that cost at most a tenth of refactorizing:
@@ -666,6 +686,7 @@ pub(crate) fn run_incremental(
     let mut factorized: Option<AssembledKey> = None;
 
     let length_tol = 1e-12 * model.size();
+    let direction_tol = SLIP_DIRECTION_TOLERANCE * model.size();
     let mut values = k_elastic.clone();
     let mut q = vec![0.0; 6 * disc.n_gnodes()];
     let mut out = IncrementalSolution {
@@ -709,6 +730,9 @@ pub(crate) fn run_incremental(
         let mut converged = None;
         // State switches per contact in this increment (chatter detection).
         let mut switches = vec![0usize; pairs.len()];
+        let mut timings = IncrementTimings::default();
+        let lap = IncrementTimings::lap;
+        let mut clock = increment_start;
         for iteration in 1..=opts.max_state_iterations {
             // Assemble K + K_N + K_T and α F + F_N + F_T for the current states.
             values.copy_from_slice(&k_elastic);
@@ -761,28 +785,35 @@ pub(crate) fn run_incremental(
                 let shared_rhs = SharedMut::new(&mut rhs);
                 for color in &contact_colors {
                     color.par_iter().with_min_len(16).for_each(|&i| {
-                        let Some((k, f)) = block(i) else { return };
                         let pair = &pairs[i];
                         let m = pair.size();
                         let slots = pattern.extra_slots(i);
                         let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
-                        for r in 0..m {
-                            let Some(ir) = disc.reduced(gdof(r)) else {
-                                continue;
-                            };
-                            // SAFETY: row r is a free DOF of a node no other contact of this
-                            // color holds, and so are the slots of row r.
-                            let rhs_r = unsafe { shared_rhs.get(ir) };
-                            *rhs_r += f[r];
-                            for c in 0..m {
-                                let s = slots[r * m + c];
-                                if s != NO_SLOT {
-                                    // SAFETY: as above.
-                                    unsafe { *shared_values.get(s as usize) += k[(r, c)] };
-                                } else if disc.reduced(gdof(c)).is_none() {
-                                    *rhs_r -= k[(r, c)] * alpha * disc.prescribed_value(gdof(c));
+                        let scatter = |k: &dyn Fn(usize, usize) -> f64, f: &BlockVector| {
+                            for r in 0..m {
+                                let Some(ir) = disc.reduced(gdof(r)) else {
+                                    continue;
+                                };
+                                // SAFETY: row r is a free DOF of a node no other contact of
+                                // this color holds, and so are the slots of row r.
+                                let rhs_r = unsafe { shared_rhs.get(ir) };
+                                *rhs_r += f[r];
+                                for c in 0..m {
+                                    let s = slots[r * m + c];
+                                    if s != NO_SLOT {
+                                        // SAFETY: as above.
+                                        unsafe { *shared_values.get(s as usize) += k(r, c) };
+                                    } else if disc.reduced(gdof(c)).is_none() {
+                                        *rhs_r -= k(r, c) * alpha * disc.prescribed_value(gdof(c));
+                                    }
                                 }
                             }
+                        };
+                        // Stuck contacts, the most, entry by entry without 30 × 30 products.
+                        if states[i] == ContactState::Stick {
+                            scatter(&pair.closed_stiffness(true), &pair.stick_load(&slips[i]));
+                        } else if let Some((k, f)) = block(i) {
+                            scatter(&|r, c| k[(r, c)], &f);
                         }
                     });
                 }
@@ -791,6 +822,7 @@ pub(crate) fn run_incremental(
                 check_supported_with(model, &closed)?;
             }
             let a = pattern.matrix(&values)?;
+            lap(&mut timings.assemble, &mut clock);
             let (slot, kind) = if nonsymmetric {
                 (&mut backends.general, SolverKind::FaerLu)
             } else {
@@ -816,6 +848,7 @@ pub(crate) fn run_incremental(
             // A symmetric factorization of nearby values preconditions CG on the new ones
             // when few contacts changed since it was computed (each change is a low-rank
             // update); otherwise, or when CG does not converge within its budget, refactorize.
+            lap(&mut timings.factorize, &mut clock);
             let mut reused = None;
             let reuse_budget = reuse_cost.budget();
             if let Some(old) = factorized.as_ref().filter(|_| n_free > 0) {
@@ -824,22 +857,23 @@ pub(crate) fn run_incremental(
                     && !old.0
                     && *old != key
                     && reuse_budget > 0
-                    && differing_states(old, &key) <= (pairs.len() / 100).max(1)
+                    && differing_blocks(old, &key) <= (pairs.len() / 100).max(1)
                     && spent_since_factor < 10 * reuse_budget
                 {
-                    let tol = 1e-3 * backward_tolerance(&opts.solve);
-                    let clock = std::time::Instant::now();
+                    let tol = REUSE_ACCURACY * backward_tolerance(&opts.solve);
+                    let started = std::time::Instant::now();
                     let r = pcg_with_factor(solver.as_mut(), a, &rhs, tol, reuse_budget)
                         .map_err(locate)?;
                     if r.iterations > 0 {
                         reuse_cost.per_iteration =
-                            Some(clock.elapsed().as_secs_f64() / r.iterations as f64);
+                            Some(started.elapsed().as_secs_f64() / r.iterations as f64);
                     }
                     reuse_iterations_done += r.iterations;
                     spent_since_factor += r.iterations.max(1);
                     if r.converged {
                         reused = Some(r);
                     }
+                    lap(&mut timings.factor_reuse, &mut clock);
                 }
             }
             let (x, report) = if let Some(r) = reused {
@@ -856,14 +890,15 @@ pub(crate) fn run_incremental(
                 (r.x, Some(report))
             } else {
                 if factorized.as_ref() != Some(&key) {
-                    let clock = std::time::Instant::now();
+                    let started = std::time::Instant::now();
                     solver.factorize(a).map_err(locate)?;
                     if !nonsymmetric {
-                        reuse_cost.factorize = Some(clock.elapsed().as_secs_f64());
+                        reuse_cost.factorize = Some(started.elapsed().as_secs_f64());
                     }
                     factorizations += 1;
                     factorized = Some(key);
                     spent_since_factor = 0;
+                    lap(&mut timings.factorize, &mut clock);
                 }
                 if n_free == 0 {
                     (Vec::new(), None)
@@ -874,6 +909,7 @@ pub(crate) fn run_incremental(
             };
             let bwd = report.as_ref().map_or(0.0, |r| r.backward_error);
             check_backward_error(&opts.solve, bwd, &format!("increment {step}"))?;
+            lap(&mut timings.solve, &mut clock);
             q = disc.generalized(&x, alpha);
             // Return mapping of every contact.
             let trials: Vec<Trial> = pairs
@@ -905,16 +941,21 @@ pub(crate) fn run_incremental(
                     }
                 })
                 .collect();
+            // A slip direction has changed when |Δd| · |u_t − s| exceeds the tolerance (see
+            // SLIP_DIRECTION_TOLERANCE).
             let changed: Vec<usize> = (0..pairs.len())
                 .filter(|&i| {
                     let t = &trials[i];
                     t.state != states[i]
                         || (t.state == ContactState::Slip
                             && friction != Friction::None
-                            && (t.direction - directions[i]).norm() > 1e-9)
+                            && t.trial_norm / pairs[i].penalty_tangent
+                                * (t.direction - directions[i]).norm()
+                                > direction_tol)
                 })
                 .collect();
             if changed.is_empty() {
+                lap(&mut timings.classify, &mut clock);
                 converged = Some((iteration, trials, report.map(|r| (r.backend, bwd))));
                 break;
             }
@@ -931,6 +972,11 @@ pub(crate) fn run_incremental(
                 directions[i] = trials[i].direction;
             }
             for (i, t) in trials.iter().enumerate() {
+                // Newton's next iterate linearizes every sliding contact at this trial: its
+                // direction too, however small the change (the spring k⊥ is anchored here).
+                if t.state == ContactState::Slip && states[i] == ContactState::Slip {
+                    directions[i] = t.direction;
+                }
                 perpendicular[i] = if t.state == ContactState::Slip && t.trial_norm > 0.0 {
                     (
                         pairs[i].penalty_tangent * t.bound / t.trial_norm,
@@ -940,6 +986,7 @@ pub(crate) fn run_incremental(
                     (0.0, Vector2::zeros())
                 };
             }
+            lap(&mut timings.classify, &mut clock);
         }
         let Some((iterations, trials, report)) = converged else {
             return Err(Error::InvalidOption("no state iteration ran".into()));
@@ -1026,6 +1073,10 @@ pub(crate) fn run_incremental(
             held: switches.iter().filter(|&&n| n >= CHATTER_SWITCHES).count(),
             backend: backend.to_string(),
             seconds: increment_start.elapsed().as_secs_f64(),
+            timings: {
+                lap(&mut timings.commit, &mut clock);
+                timings
+            },
             backward_error: bwd,
         });
         out.contact_results.push(records);

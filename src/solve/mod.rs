@@ -2,12 +2,14 @@
 
 mod backend;
 mod connectivity;
+mod increment_timings;
 mod incremental;
 mod reduced;
 mod static_solve;
 
 pub use backend::{make_solver, SolverKind};
 pub use connectivity::{check_supported, check_supported_with};
+pub use increment_timings::IncrementTimings;
 pub(crate) use incremental::run_incremental;
 pub use incremental::{
     solve_incremental, ContactRecord, IncrementRecord, IncrementalOptions, IncrementalSolution,

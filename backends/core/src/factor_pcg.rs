@@ -5,7 +5,7 @@
 //! pair of triangular solves and one product with A: far less than a refactorization while k is
 //! small.
 
-use crate::{CscRef, LinearSolver, SolverError};
+use crate::{norm_inf, vector_norm_inf, CscRef, LinearSolver, SolverError};
 
 /// The outcome of [`pcg_with_factor`].
 #[derive(Clone, Debug, PartialEq)]
@@ -33,12 +33,8 @@ pub fn pcg_with_factor(
 ) -> Result<FactorPcg, SolverError> {
     let n = a.ncols();
     <dyn LinearSolver>::check_rhs(n, b, 1)?;
-    let mut row_sums = vec![0.0; n];
-    for (&i, v) in a.row_idx().iter().zip(a.values()) {
-        row_sums[i] += v.abs();
-    }
-    let norm_a = row_sums.iter().fold(0.0f64, |m, v| m.max(*v));
-    let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let norm_a = norm_inf(a);
+    let inf = vector_norm_inf;
     let norm_b = inf(b);
     let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(p, q)| p * q).sum::<f64>();
     let backward = |r: &[f64], x: &[f64]| {

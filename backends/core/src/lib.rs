@@ -29,5 +29,7 @@ pub use error::{SolverError, StopReason};
 pub use factor_pcg::{pcg_with_factor, FactorPcg};
 pub use lower::LowerTriangle;
 pub use ordering::{compute_ordering, Ordering, Permutation};
-pub use residual::{backward_error, relative_residual, solve_checked, SolveReport};
+pub use residual::{
+    backward_error, norm_inf, relative_residual, solve_checked, vector_norm_inf, SolveReport,
+};
 pub use solver::{AnalyzeInfo, Capabilities, LinearSolver, SolveInfo};

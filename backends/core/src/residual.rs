@@ -20,6 +20,11 @@ pub struct SolveReport {
 pub fn relative_residual(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
     let mut ax = vec![0.0; a.nrows()];
     a.mul_vec(x, &mut ax);
+    relative_from_product(&ax, b)
+}
+
+/// ‖Ax − b‖₂ / ‖b‖₂ from the product `ax` = Ax.
+fn relative_from_product(ax: &[f64], b: &[f64]) -> f64 {
     let r: f64 = ax
         .iter()
         .zip(b)
@@ -34,21 +39,34 @@ pub fn relative_residual(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
     }
 }
 
-/// Normwise backward error ‖Ax − b‖∞ / (‖A‖∞‖x‖∞ + ‖b‖∞) (0 when all vanish).
-pub fn backward_error(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
-    let mut ax = vec![0.0; a.nrows()];
-    a.mul_vec(x, &mut ax);
-    let r = ax
-        .iter()
-        .zip(b)
-        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+/// ‖A‖∞, the largest absolute row sum of the stored entries (A given in full).
+pub fn norm_inf(a: CscRef<'_>) -> f64 {
     let mut row_sums = vec![0.0; a.nrows()];
     for (&i, v) in a.row_idx().iter().zip(a.values()) {
         row_sums[i] += v.abs();
     }
-    let norm_a = row_sums.iter().fold(0.0f64, |m, v| m.max(*v));
-    let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let denom = norm_a * inf(x) + inf(b);
+    row_sums.iter().fold(0.0f64, |m, v| m.max(*v))
+}
+
+/// ‖v‖∞ (0 for an empty vector).
+pub fn vector_norm_inf(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Normwise backward error ‖Ax − b‖∞ / (‖A‖∞‖x‖∞ + ‖b‖∞) (0 when all vanish).
+pub fn backward_error(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
+    let mut ax = vec![0.0; a.nrows()];
+    a.mul_vec(x, &mut ax);
+    backward_from_product(a, &ax, x, b)
+}
+
+/// The backward error from the product `ax` = Ax.
+fn backward_from_product(a: CscRef<'_>, ax: &[f64], x: &[f64], b: &[f64]) -> f64 {
+    let r = ax
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+    let denom = norm_inf(a) * vector_norm_inf(x) + vector_norm_inf(b);
     if denom > 0.0 {
         r / denom
     } else {
@@ -76,10 +94,12 @@ pub fn solve_checked(
         });
     }
     let (mut relative, mut backward) = (0.0f64, 0.0f64);
+    let mut ax = vec![0.0; a.nrows()];
     for k in 0..nrhs {
         let cols = k * n..(k + 1) * n;
-        relative = relative.max(relative_residual(a, &x[cols.clone()], &b[cols.clone()]));
-        backward = backward.max(backward_error(a, &x[cols.clone()], &b[cols]));
+        a.mul_vec(&x[cols.clone()], &mut ax);
+        relative = relative.max(relative_from_product(&ax, &b[cols.clone()]));
+        backward = backward.max(backward_from_product(a, &ax, &x[cols.clone()], &b[cols]));
     }
     Ok((
         x,
