@@ -413,3 +413,98 @@ fn unavailable_backend_is_an_error_not_a_panic() {
         .unwrap_err()
         .contains("umfpack"));
 }
+
+/// W: three sparse columns over rows of `a`, each entry half the square root of the diagonal.
+fn low_rank(a: CscRef<'_>) -> CscMatrix {
+    let n = a.nrows();
+    let diag = |r: usize| {
+        let (rows, vals) = a.col(r);
+        rows.iter()
+            .zip(vals)
+            .find(|(&i, _)| i == r)
+            .map_or(0.0, |(_, v)| *v)
+    };
+    let columns = [vec![0, n / 2], vec![5, 6], vec![n - 1]];
+    let mut triplets = Vec::new();
+    for (j, rows) in columns.iter().enumerate() {
+        for &r in rows {
+            triplets.push((r, j, 0.5 * diag(r).sqrt()));
+        }
+    }
+    CscMatrix::from_triplets(n, columns.len(), &triplets).unwrap()
+}
+
+/// A + sign · W Wᵀ assembled explicitly.
+#[cfg_attr(not(feature = "cholmod"), allow(dead_code))]
+fn plus_outer(a: CscRef<'_>, w: CscRef<'_>, sign: f64) -> CscMatrix {
+    let mut triplets = Vec::new();
+    for j in 0..a.ncols() {
+        let (rows, vals) = a.col(j);
+        triplets.extend(rows.iter().zip(vals).map(|(&i, &v)| (i, j, v)));
+    }
+    for k in 0..w.ncols() {
+        let (rows, vals) = w.col(k);
+        for (&i, &u) in rows.iter().zip(vals) {
+            for (&j, &v) in rows.iter().zip(vals) {
+                triplets.push((i, j, sign * u * v));
+            }
+        }
+    }
+    CscMatrix::from_triplets(a.nrows(), a.ncols(), &triplets).unwrap()
+}
+
+/// A factor updated by W Wᵀ, then downdated back, solves as the refactorized matrices do
+/// (1e-9 relative); a backend without the capability says so.
+#[test]
+fn low_rank_update_and_downdate_match_a_refactorization() {
+    let (_, sys) = systems().pop().unwrap();
+    let a = sys.matrix().unwrap();
+    let w = low_rank(a);
+    let mut faer = FaerCholesky::default();
+    faer.analyze(a).unwrap();
+    faer.factorize(a).unwrap();
+    assert!(matches!(
+        faer.update_factor(w.as_ref(), true),
+        Err(SolverError::Unavailable { .. })
+    ));
+    #[cfg(feature = "cholmod")]
+    for o in [Ordering::Auto, Ordering::NestedDissection] {
+        let n = a.nrows();
+        let b: Vec<f64> = (0..n).map(|i| ((i % 7) as f64 - 3.0) * 1e-3).collect();
+        let updated = plus_outer(a, w.as_ref(), 1.0);
+        let close = |x: &[f64], y: &[f64]| {
+            let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            x.iter().zip(y).all(|(p, q)| (p - q).abs() <= 1e-9 * scale)
+        };
+        let mut s = fibercell_cholmod::Cholmod::new(o.clone());
+        s.analyze(a).unwrap();
+        s.factorize(a).unwrap();
+        s.update_factor(w.as_ref(), true).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x, 1).unwrap();
+        assert!(
+            close(&x, &reference(updated.as_ref(), &b)),
+            "update {}",
+            o.name()
+        );
+        s.update_factor(w.as_ref(), false).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x, 1).unwrap();
+        assert!(close(&x, &reference(a, &b)), "downdate {}", o.name());
+        // A new factorization drops the modification.
+        s.update_factor(w.as_ref(), true).unwrap();
+        s.factorize(a).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x, 1).unwrap();
+        assert!(close(&x, &reference(a, &b)), "refactorized {}", o.name());
+        // Downdating past positive definiteness is a typed error.
+        let mut big = w.clone();
+        big.values_mut().iter_mut().for_each(|v| *v *= 10.0);
+        let r = s.update_factor(big.as_ref(), false);
+        assert!(matches!(r, Err(SolverError::NotPositiveDefinite { .. })));
+        assert!(matches!(
+            s.solve_in_place(&mut x, 1),
+            Err(SolverError::OutOfOrder(..))
+        ));
+    }
+}

@@ -9,23 +9,15 @@
 //! set by roundoff: about 3e-7 of the scale, measured in a debug build; 1e-10 on the benchmark's
 //! S cell, where none is held).
 
-use fibercell::generate::{nonwoven, FiberAmount, LengthDistribution, NonWoven};
+mod common;
+use common::small_nonwoven;
 use fibercell::homogenize::{elasto_plastic_curve, Curve, CurveOptions};
 use fibercell::model::FrictionSpec;
 use fibercell::solve::IncrementalOptions;
 use fibercell::Model;
 
 fn curve(reuse_factor: bool) -> Curve {
-    let generated = nonwoven(&NonWoven {
-        size: [3e-3, 3e-3],
-        amount: FiberAmount::Count { fibers: 50 },
-        length: LengthDistribution::Fixed { length: 1.2e-3 },
-        element_length: 2.5e-4,
-        seed: 7,
-        ..NonWoven::default()
-    })
-    .unwrap();
-    let mut desc = generated.description;
+    let mut desc = small_nonwoven();
     desc.contact.as_mut().unwrap().friction = FrictionSpec::Tresca { bound: 3e-6 };
     let model = Model::from_description(&desc).unwrap();
     elasto_plastic_curve(

@@ -14,7 +14,7 @@ use crate::homogenize::{
 use crate::model::{FrictionSpec, Model};
 use crate::solve::{make_solver, IncrementalOptions, SolveOptions, SolverKind};
 use crate::Error;
-use fibercell_solver::{pcg_with_factor, CscRef, Ordering};
+use fibercell_solver::{backward_error, pcg_with_factor, CscMatrix, CscRef, Ordering};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -82,6 +82,57 @@ pub struct ReuseBench {
     pub seconds: f64,
     /// Its cost relative to a numeric factorization plus solve.
     pub ratio_to_refactorization: f64,
+    /// CHOLMOD's downdate of its factor by the switched contacts' stick springs (rank 2k,
+    /// [`PeriodicSystem::stick_spring_columns`]) plus one solve (s), the first after a
+    /// factorization: it includes copying the supernodal factor into a simplicial LDLᵀ. Absent
+    /// without the cholmod feature.
+    #[serde(default)]
+    pub updown_seconds: Option<f64>,
+    /// That relative to CHOLMOD's own numeric factorization plus solve.
+    #[serde(default)]
+    pub updown_ratio: Option<f64>,
+    /// Normwise backward error of that solve on the switched matrix (the larger with the
+    /// next one's on the original matrix).
+    #[serde(default)]
+    pub updown_backward_error: Option<f64>,
+    /// The next modification of the same factor, the update that switches the contacts back,
+    /// plus one solve (s): the cost once the factor is simplicial.
+    #[serde(default)]
+    pub updown_next_seconds: Option<f64>,
+    /// That relative to CHOLMOD's numeric factorization plus solve.
+    #[serde(default)]
+    pub updown_next_ratio: Option<f64>,
+}
+
+/// A factorized solver and the seconds of its numeric factorization plus one solve.
+type TimedSolver = (Box<dyn fibercell_solver::LinearSolver>, f64);
+
+/// CHOLMOD (when built with it) factorized on the unswitched matrix `a0`.
+fn updown_solver(a0: CscRef<'_>, rhs: &[f64]) -> Result<Option<TimedSolver>, Error> {
+    let Ok(mut solver) = make_solver(SolverKind::Cholmod, &Ordering::Auto, Vec::new()) else {
+        return Ok(None);
+    };
+    solver.analyze(a0)?;
+    let t = Instant::now();
+    solver.factorize(a0)?;
+    let mut x = rhs.to_vec();
+    solver.solve_in_place(&mut x, 1)?;
+    Ok(Some((solver, t.elapsed().as_secs_f64())))
+}
+
+/// The n × 2k matrix W of the stick springs of `switched` contacts (K_stick − K_sliding = W Wᵀ).
+fn stick_springs(sys: &PeriodicSystem, switched: &[usize]) -> Result<CscMatrix, Error> {
+    let mut triplets = Vec::new();
+    for (k, &i) in switched.iter().enumerate() {
+        for (j, column) in sys.stick_spring_columns(i).into_iter().enumerate() {
+            triplets.extend(column.into_iter().map(|(r, v)| (r, 2 * k + j, v)));
+        }
+    }
+    Ok(CscMatrix::from_triplets(
+        sys.n_free(),
+        2 * switched.len(),
+        &triplets,
+    )?)
 }
 
 /// The incremental elasto-plastic curve.
@@ -270,16 +321,18 @@ fn bench_reuse(
     let refactor = t.elapsed().as_secs_f64();
     // Past twice a refactorization's time the crossover is behind: stop CG there.
     let max_iterations = ((2.0 * refactor / solve.max(1e-9)).ceil() as usize).clamp(10, 500);
+    let mut updown = updown_solver(a0, rhs)?;
     let n_contacts = sys.n_contacts();
     let mut out = Vec::new();
     for &fraction in fractions {
         let k = ((fraction * n_contacts as f64).round() as usize).max(1);
         // Every (n/k)-th contact slides: spread over the cell.
         let stride = (n_contacts / k).max(1);
+        let switched = |i: usize| i.is_multiple_of(stride) && i / stride < k;
         let mut values = sys.zero_values();
         sys.add_elements(model, &mut values);
         sys.add_contacts(&mut values, |i| {
-            if i % stride == 0 && i / stride < k {
+            if switched(i) {
                 ContactStiffness::Sliding
             } else {
                 ContactStiffness::Stick
@@ -289,6 +342,26 @@ fn bench_reuse(
         let t = Instant::now();
         let r = pcg_with_factor(factor.as_mut(), a, rhs, 1e-13, max_iterations)?;
         let seconds = t.elapsed().as_secs_f64();
+        let mut measured = None;
+        let cholmod_refactor = updown.as_ref().map_or(f64::NAN, |u| u.1);
+        if let Some((solver, _)) = updown.as_mut() {
+            let list: Vec<usize> = (0..n_contacts).filter(|&i| switched(i)).collect();
+            let w = stick_springs(sys, &list)?;
+            solver.factorize(a0)?;
+            let t = Instant::now();
+            solver.update_factor(w.as_ref(), false)?;
+            let mut x = rhs.to_vec();
+            solver.solve_in_place(&mut x, 1)?;
+            let seconds = t.elapsed().as_secs_f64();
+            let error = backward_error(a, &x, rhs);
+            let t = Instant::now();
+            solver.update_factor(w.as_ref(), true)?;
+            let mut x = rhs.to_vec();
+            solver.solve_in_place(&mut x, 1)?;
+            let next = t.elapsed().as_secs_f64();
+            let error = error.max(backward_error(a0, &x, rhs));
+            measured = Some((seconds, error, next));
+        }
         out.push(ReuseBench {
             switched: k,
             fraction: k as f64 / n_contacts.max(1) as f64,
@@ -296,6 +369,11 @@ fn bench_reuse(
             converged: r.converged,
             seconds,
             ratio_to_refactorization: seconds / refactor,
+            updown_seconds: measured.map(|m| m.0),
+            updown_ratio: measured.map(|m| m.0 / cholmod_refactor),
+            updown_backward_error: measured.map(|m| m.1),
+            updown_next_seconds: measured.map(|m| m.2),
+            updown_next_ratio: measured.map(|m| m.2 / cholmod_refactor),
         });
     }
     Ok(out)

@@ -179,21 +179,30 @@ pub fn markdown(r: &BenchReport) -> String {
     let _ = writeln!(s);
     let _ = writeln!(
         s,
-        "| cell | contacts switched | fraction | CG iterations | seconds | of a refactorization |"
+        "| cell | contacts switched | fraction | CG on the old factor: iterations | seconds | \
+         of a refactorization | CHOLMOD downdate + solve, first | next | of CHOLMOD's \
+         refactorization (first / next) | backward error |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for c in &r.cells {
         for u in &c.reuse {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.1} % | {}{} | {} | {:.2} |",
+                "| {} | {} | {:.1} % | {}{} | {} | {:.2} | {} | {} | {} | {} |",
                 c.cell,
                 u.switched,
                 100.0 * u.fraction,
                 u.iterations,
                 if u.converged { "" } else { " (not converged)" },
                 ms(u.seconds),
-                u.ratio_to_refactorization
+                u.ratio_to_refactorization,
+                opt(u.updown_seconds.map(ms)),
+                opt(u.updown_next_seconds.map(ms)),
+                match (u.updown_ratio, u.updown_next_ratio) {
+                    (Some(a), Some(b)) => format!("{a:.2} / {b:.2}"),
+                    _ => "–".into(),
+                },
+                opt(u.updown_backward_error.map(|x| format!("{x:.1e}"))),
             );
         }
     }

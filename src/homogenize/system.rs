@@ -238,6 +238,32 @@ impl PeriodicSystem {
         self.contacts.len()
     }
 
+    /// The columns w₁, w₂ with K_T^st = p_T Bᵀ(t₁t₁ᵀ + t₂t₂ᵀ)B = w₁w₁ᵀ + w₂w₂ᵀ (4.58) of
+    /// closed contact `i` on the free DOFs, as (row of K_ff, value) sorted by row: switching
+    /// the contact from stick to sliding is the rank-2 downdate K_ff − w₁w₁ᵀ − w₂w₂ᵀ.
+    pub fn stick_spring_columns(&self, i: usize) -> [Vec<(usize, f64)>; 2] {
+        let pair = &self.contacts[i];
+        let root = pair.penalty_tangent.sqrt();
+        pair.tangents.map(|t| {
+            let mut column: Vec<(usize, f64)> = (0..pair.size())
+                .filter_map(|r| {
+                    let g = 6 * pair.jump.nodes[r / 6] + r % 6;
+                    let row = self.discretization.reduced(g)?;
+                    Some((row, root * pair.jump.b.column(r).dot(&t)))
+                })
+                .collect();
+            column.sort_unstable_by_key(|e| e.0);
+            column.dedup_by(|next, kept| {
+                let same = next.0 == kept.0;
+                if same {
+                    kept.1 += next.1;
+                }
+                same
+            });
+            column
+        })
+    }
+
     /// Assembles K_ff, K_fE and K_EE (elements and closed contacts in stick).
     pub fn assemble(&self, model: &Model) -> PeriodicValues {
         let mut out = self.zero_values();

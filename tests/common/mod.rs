@@ -220,3 +220,19 @@ impl GridCell {
         d
     }
 }
+
+/// A small periodic non-woven cell: 50 fibers of 1.2 mm in 3 mm × 3 mm, elements ≤ 0.25 mm,
+/// seed 7, with the generator's polypropylene defaults.
+pub fn small_nonwoven() -> ModelDescription {
+    use fibercell::generate::{nonwoven, FiberAmount, LengthDistribution, NonWoven};
+    nonwoven(&NonWoven {
+        size: [3e-3, 3e-3],
+        amount: FiberAmount::Count { fibers: 50 },
+        length: LengthDistribution::Fixed { length: 1.2e-3 },
+        element_length: 2.5e-4,
+        seed: 7,
+        ..NonWoven::default()
+    })
+    .unwrap()
+    .description
+}

@@ -32,6 +32,10 @@ struct State {
     values: Vec<f64>,
     scale: Vec<f64>,
     factor: *mut ss::cholmod_factor,
+    /// A copy of `factor` modified by `update_factor` (a simplicial LDLᵀ), used by the solves
+    /// until the next factorization; null when none. The supernodal `factor` is kept for the
+    /// next numeric factorization.
+    modified: *mut ss::cholmod_factor,
     factorized: bool,
 }
 
@@ -63,7 +67,18 @@ impl Cholmod {
         self
     }
 
+    fn free_modified(&mut self) {
+        if let (Some(c), Some(s)) = (self.common.as_mut(), self.state.as_mut()) {
+            if !s.modified.is_null() {
+                // SAFETY: `modified` came from cholmod_l_copy_factor with this common.
+                unsafe { ss::cholmod_l_free_factor(&mut s.modified, c.as_mut_ptr()) };
+                s.modified = std::ptr::null_mut();
+            }
+        }
+    }
+
     fn free_factor(&mut self) {
+        self.free_modified();
         if let (Some(c), Some(s)) = (self.common.as_mut(), self.state.as_mut()) {
             if !s.factor.is_null() {
                 // SAFETY: `factor` came from cholmod_l_analyze_p with this common.
@@ -161,6 +176,7 @@ impl LinearSolver for Cholmod {
             values: vec![0.0; nnz],
             scale: vec![1.0; n],
             factor: std::ptr::null_mut(),
+            modified: std::ptr::null_mut(),
             factorized: false,
         };
         let common = self
@@ -196,6 +212,7 @@ impl LinearSolver for Cholmod {
     }
 
     fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError> {
+        self.free_modified();
         let tol = self.pivot_tolerance;
         let (common, s) = match (self.common.as_mut(), self.state.as_mut()) {
             (Some(c), Some(s)) => (c, s),
@@ -269,7 +286,12 @@ impl LinearSolver for Cholmod {
         // SAFETY: `b` describes `rhs` (n × nrhs, leading dimension n); the result is a new
         // dense matrix that we copy out of and free with the same common.
         unsafe {
-            let mut x = ss::cholmod_l_solve(ss::CHOLMOD_A as c_int, s.factor, &mut b, c);
+            let factor = if s.modified.is_null() {
+                s.factor
+            } else {
+                s.modified
+            };
+            let mut x = ss::cholmod_l_solve(ss::CHOLMOD_A as c_int, factor, &mut b, c);
             if x.is_null() {
                 return Err(backend_error((*c).status, "cholmod_l_solve"));
             }
@@ -281,5 +303,121 @@ impl LinearSolver for Cholmod {
             col.iter_mut().zip(&s.scale).for_each(|(x, d)| *x *= d);
         }
         Ok(SolveInfo::default())
+    }
+
+    /// cholmod_l_updown on a copy of the factor (CHOLMOD converts it to a simplicial LDLᵀ;
+    /// the supernodal original stays for the next `factorize`), with W scaled like A and
+    /// permuted to L's order, as CHOLMOD requires.
+    fn update_factor(&mut self, w: CscRef<'_>, update: bool) -> Result<(), SolverError> {
+        let (common, s) = match (self.common.as_mut(), self.state.as_mut()) {
+            (Some(c), Some(s)) if s.factorized => (c, s),
+            _ => return Err(SolverError::OutOfOrder("update_factor", "factorize")),
+        };
+        let n = s.n;
+        if w.nrows() != n {
+            return Err(SolverError::DimensionMismatch(format!(
+                "W has {} rows, the factor {n}",
+                w.nrows()
+            )));
+        }
+        if let Some(i) = w.values().iter().position(|v| !v.is_finite()) {
+            return Err(SolverError::NonFinite {
+                what: "update column",
+                index: i,
+            });
+        }
+        if w.ncols() == 0 || n == 0 {
+            return Ok(());
+        }
+        let c = common.as_mut_ptr();
+        // SAFETY: after analyze, Perm holds the n entries of the fill-reducing permutation.
+        let perm = unsafe {
+            let p = (*s.factor).Perm as *const c_long;
+            if p.is_null() {
+                return Err(SolverError::OutOfOrder("update_factor", "analyze"));
+            }
+            std::slice::from_raw_parts(p, n)
+        };
+        let mut inverse = vec![0usize; n];
+        for (k, &p) in perm.iter().enumerate() {
+            inverse[p as usize] = k;
+        }
+        // Cnew = P S W, columns sorted by the permuted row.
+        let mut col_ptr: Vec<c_long> = Vec::with_capacity(w.ncols() + 1);
+        let mut row_idx: Vec<c_long> = Vec::with_capacity(w.nnz());
+        let mut values: Vec<f64> = Vec::with_capacity(w.nnz());
+        col_ptr.push(0);
+        let mut column: Vec<(usize, f64)> = Vec::new();
+        for j in 0..w.ncols() {
+            let (rows, vals) = w.col(j);
+            column.clear();
+            column.extend(
+                rows.iter()
+                    .zip(vals)
+                    .map(|(&r, &v)| (inverse[r], v * s.scale[r])),
+            );
+            column.sort_unstable_by_key(|e| e.0);
+            for &(r, v) in &column {
+                row_idx.push(r as c_long);
+                values.push(v);
+            }
+            col_ptr.push(row_idx.len() as c_long);
+        }
+        let mut header = ss::cholmod_sparse {
+            nrow: n,
+            ncol: w.ncols(),
+            nzmax: row_idx.len(),
+            p: col_ptr.as_mut_ptr() as *mut c_void,
+            i: row_idx.as_mut_ptr() as *mut c_void,
+            nz: std::ptr::null_mut(),
+            x: values.as_mut_ptr() as *mut c_void,
+            z: std::ptr::null_mut(),
+            stype: 0,
+            itype: ss::CHOLMOD_LONG as c_int,
+            xtype: ss::CHOLMOD_REAL as c_int,
+            dtype: ss::CHOLMOD_DOUBLE as c_int,
+            sorted: 1,
+            packed: 1,
+        };
+        // SAFETY: factor, modified and common belong together; the header points to live
+        // arrays of the declared sizes.
+        let (ok, status, minor) = unsafe {
+            if s.modified.is_null() {
+                s.modified = ss::cholmod_l_copy_factor(s.factor, c);
+                if s.modified.is_null() {
+                    return Err(backend_error((*c).status, "cholmod_l_copy_factor"));
+                }
+            }
+            let ok = ss::cholmod_l_updown(c_int::from(update), &mut header, s.modified, c);
+            (ok, (*c).status, (*s.modified).minor)
+        };
+        if ok == 0 || status < 0 {
+            // The modified factor may be left symbolic: no solve until the next factorize.
+            s.factorized = false;
+            return Err(backend_error(status, "cholmod_l_updown"));
+        }
+        // A downdate past positive definiteness leaves a non-positive D in the LDLᵀ factor
+        // without an error from CHOLMOD: look at D (the first entry of each column).
+        // SAFETY: after a successful updown, `modified` is a simplicial LDLᵀ of order n whose
+        // column j starts at p[j] with its diagonal entry.
+        let bad = unsafe {
+            let (p, x) = (
+                (*s.modified).p as *const c_long,
+                (*s.modified).x as *const f64,
+            );
+            (0..n)
+                .map(|j| (j, *x.add(*p.add(j) as usize)))
+                .find(|&(_, d)| !(d > 0.0))
+        };
+        let not_definite = status == ss::CHOLMOD_NOT_POSDEF as c_int || minor < n;
+        if not_definite || bad.is_some() {
+            s.factorized = false;
+            let (k, pivot) = bad.unwrap_or((minor.min(n - 1), 0.0));
+            return Err(SolverError::NotPositiveDefinite {
+                column: perm[k] as usize,
+                pivot,
+            });
+        }
+        Ok(())
     }
 }

@@ -66,6 +66,17 @@ pub trait LinearSolver: Send {
     fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError>;
     /// Solves A X = B in place; `rhs` holds `nrhs` columns of length n, column after column.
     fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError>;
+    /// Turns the current factorization of A into one of A + W Wᵀ (`update`) or A − W Wᵀ
+    /// (downdate) without refactorizing, W an n × k matrix (e.g. the square roots of k contact
+    /// springs switched on or off); later solves use it until the next `factorize`. Backends
+    /// without a low-rank modification return [`SolverError::Unavailable`] (the default).
+    fn update_factor(&mut self, w: CscRef<'_>, update: bool) -> Result<(), SolverError> {
+        let _ = (w, update);
+        Err(SolverError::Unavailable {
+            backend: self.name(),
+            reason: "no low-rank update or downdate of the factor".into(),
+        })
+    }
 }
 
 impl dyn LinearSolver {
