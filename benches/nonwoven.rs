@@ -2,7 +2,8 @@
 //! search with periodic images (segments/s), value fill of the elements and of the closed
 //! contacts of the periodic cell system (elements/s, pairs/s), numeric factorization with the
 //! pattern analyzed once (faer, and CHOLMOD with the feature), and the solve after one contact
-//! switch by CG on the previous factor. `fibercell bench` runs the same stages (and the cell
+//! switch by CG on the previous factor (and, with the feature, by a rank-2 downdate of
+//! CHOLMOD's factor). `fibercell bench` runs the same stages (and the cell
 //! problems, the curve, L) with the machine's limits alongside.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
@@ -12,7 +13,7 @@ use fibercell::generate::{nonwoven, nonwoven_preset};
 use fibercell::homogenize::{ContactStiffness, PeriodicSystem};
 use fibercell::solve::{make_solver, SolverKind};
 use fibercell::Model;
-use fibercell_solver::{pcg_with_factor, Ordering};
+use fibercell_solver::{pcg_with_factor, CscMatrix, Ordering};
 use std::hint::black_box;
 
 fn stages(c: &mut Criterion) {
@@ -85,6 +86,26 @@ fn stages(c: &mut Criterion) {
                 black_box(r.iterations)
             })
         });
+        if let Ok(mut chol) = make_solver(SolverKind::Cholmod, &Ordering::Auto, Vec::new()) {
+            // The switch as a rank-2 downdate of CHOLMOD's factor, a solve, and the update
+            // back (the factor stays simplicial after the first modification).
+            let mut triplets = Vec::new();
+            for (j, column) in sys.stick_spring_columns(0).into_iter().enumerate() {
+                triplets.extend(column.into_iter().map(|(r, v)| (r, j, v)));
+            }
+            let w = CscMatrix::from_triplets(sys.n_free(), 2, &triplets).expect("columns");
+            chol.analyze(a).expect("analysis");
+            chol.factorize(a).expect("factorization");
+            g.bench_function(format!("downdate, solve, update cholmod/{size}"), |b| {
+                b.iter(|| {
+                    chol.update_factor(w.as_ref(), false).expect("downdate");
+                    let mut x = rhs.clone();
+                    chol.solve_in_place(&mut x, 1).expect("solve");
+                    chol.update_factor(w.as_ref(), true).expect("update");
+                    black_box(x[0])
+                })
+            });
+        }
     }
     g.finish();
 }
