@@ -13,7 +13,7 @@ use fibercell::generate::{nonwoven, nonwoven_preset};
 use fibercell::homogenize::{ContactStiffness, PeriodicSystem};
 use fibercell::solve::{make_solver, SolverKind};
 use fibercell::Model;
-use fibercell_solver::{pcg_with_factor, CscMatrix, Ordering};
+use fibercell_solver::{pcg_with_factor, Ordering};
 use std::hint::black_box;
 
 fn stages(c: &mut Criterion) {
@@ -89,11 +89,7 @@ fn stages(c: &mut Criterion) {
         if let Ok(mut chol) = make_solver(SolverKind::Cholmod, &Ordering::Auto, Vec::new()) {
             // The switch as a rank-2 downdate of CHOLMOD's factor, a solve, and the update
             // back (the factor stays simplicial after the first modification).
-            let mut triplets = Vec::new();
-            for (j, column) in sys.stick_spring_columns(0).into_iter().enumerate() {
-                triplets.extend(column.into_iter().map(|(r, v)| (r, j, v)));
-            }
-            let w = CscMatrix::from_triplets(sys.n_free(), 2, &triplets).expect("columns");
+            let w = sys.stick_spring_matrix(&[0]).expect("columns");
             chol.analyze(a).expect("analysis");
             chol.factorize(a).expect("factorization");
             g.bench_function(format!("downdate, solve, update cholmod/{size}"), |b| {

@@ -132,7 +132,7 @@ pub fn markdown(r: &BenchReport) -> String {
         },
     );
     row(
-        "… assemble / factorize / factor reuse / solve / classify / commit",
+        &format!("… {}", crate::solve::IncrementTimings::NAMES.join(" / ")),
         &|c| {
             c.curve
                 .as_ref()

@@ -12,6 +12,7 @@ use crate::constraints::Discretization;
 use crate::contact::{ContactPair, ContactSet, ContactSide};
 use crate::model::{Dof, Model};
 use crate::Error;
+use fibercell_solver::CscMatrix;
 use nalgebra::{DMatrix, SMatrix};
 use rayon::prelude::*;
 
@@ -262,6 +263,24 @@ impl PeriodicSystem {
             });
             column
         })
+    }
+
+    /// The n × 2k matrix W of the stick springs of the closed contacts `switched` (columns 2j,
+    /// 2j + 1 from [`PeriodicSystem::stick_spring_columns`] of the j-th): K_ff with them stuck
+    /// minus K_ff with them sliding is W Wᵀ, the argument of a factor downdate
+    /// (`LinearSolver::update_factor`).
+    pub fn stick_spring_matrix(&self, switched: &[usize]) -> Result<CscMatrix, Error> {
+        let mut triplets = Vec::new();
+        for (k, &i) in switched.iter().enumerate() {
+            for (j, column) in self.stick_spring_columns(i).into_iter().enumerate() {
+                triplets.extend(column.into_iter().map(|(r, v)| (r, 2 * k + j, v)));
+            }
+        }
+        Ok(CscMatrix::from_triplets(
+            self.n_free(),
+            2 * switched.len(),
+            &triplets,
+        )?)
     }
 
     /// Assembles K_ff, K_fE and K_EE (elements and closed contacts in stick).

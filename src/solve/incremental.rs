@@ -744,43 +744,30 @@ pub(crate) fn run_incremental(
                 .collect();
             let nonsymmetric = matches!(friction, Friction::Coulomb { mu } if mu > 0.0)
                 && states.contains(&ContactState::Slip);
+            // K_N + K_T^sl (+ the consistent tangent k⊥ across the slip direction) + K_R
+            // (+ ε K_T^st) and its load, of a sliding contact.
+            let sliding_block = |i: usize| -> (BlockMatrix, BlockVector) {
+                let pair = &pairs[i];
+                let (mut k, mut f) = pair.normal();
+                let (ks, fs) = pair.slip(friction, &directions[i]);
+                k += ks + pair.rotation();
+                f += fs;
+                if perpendicular[i].0 > 0.0 {
+                    let (kp, fp) = pair.slip_perpendicular(
+                        &directions[i],
+                        perpendicular[i].0,
+                        &perpendicular[i].1,
+                    );
+                    k += kp;
+                    f += fp;
+                }
+                if stabilization > 0.0 {
+                    k += stabilizer(pair, ContactState::Slip) * stabilization;
+                }
+                (k, f)
+            };
             // The contact blocks for the current states, computed and scattered in parallel
             // color by color (sums independent of the number of threads).
-            let block = |i: usize| -> Option<(BlockMatrix, BlockVector)> {
-                let pair = &pairs[i];
-                match states[i] {
-                    ContactState::Open if stabilization > 0.0 => Some((
-                        stabilizer(pair, states[i]) * stabilization,
-                        BlockVector::zeros(),
-                    )),
-                    ContactState::Open => None,
-                    state => {
-                        let (mut k, mut f) = pair.normal();
-                        let (kt, ft) = match state {
-                            ContactState::Stick => pair.stick(&slips[i]),
-                            _ => {
-                                let (mut k, mut f) = pair.slip(friction, &directions[i]);
-                                if perpendicular[i].0 > 0.0 {
-                                    let (kp, fp) = pair.slip_perpendicular(
-                                        &directions[i],
-                                        perpendicular[i].0,
-                                        &perpendicular[i].1,
-                                    );
-                                    k += kp;
-                                    f += fp;
-                                }
-                                if stabilization > 0.0 {
-                                    k += stabilizer(pair, state) * stabilization;
-                                }
-                                (k, f)
-                            }
-                        };
-                        k += kt + pair.rotation();
-                        f += ft;
-                        Some((k, f))
-                    }
-                }
-            };
             {
                 let shared_values = SharedMut::new(&mut values);
                 let shared_rhs = SharedMut::new(&mut rhs);
@@ -810,11 +797,21 @@ pub(crate) fn run_incremental(
                                 }
                             }
                         };
-                        // Stuck contacts, the most, entry by entry without 30 × 30 products.
-                        if states[i] == ContactState::Stick {
-                            scatter(&pair.closed_stiffness(true), &pair.stick_load(&slips[i]));
-                        } else if let Some((k, f)) = block(i) {
-                            scatter(&|r, c| k[(r, c)], &f);
+                        match states[i] {
+                            // Stuck contacts, the most, entry by entry: K_N + K_T^st + K_R.
+                            ContactState::Stick => {
+                                scatter(&pair.closed_stiffness(true), &pair.stick_load(&slips[i]))
+                            }
+                            // ε (K_N + K_T^st + K_R), the open contact's stabilizer.
+                            ContactState::Open if stabilization > 0.0 => {
+                                let k = pair.closed_stiffness(true);
+                                scatter(&|r, c| stabilization * k(r, c), &BlockVector::zeros())
+                            }
+                            ContactState::Open => {}
+                            ContactState::Slip => {
+                                let (k, f) = sliding_block(i);
+                                scatter(&|r, c| k[(r, c)], &f)
+                            }
                         }
                     });
                 }

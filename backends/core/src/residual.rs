@@ -57,16 +57,16 @@ pub fn vector_norm_inf(v: &[f64]) -> f64 {
 pub fn backward_error(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
     let mut ax = vec![0.0; a.nrows()];
     a.mul_vec(x, &mut ax);
-    backward_from_product(a, &ax, x, b)
+    backward_from_product(norm_inf(a), &ax, x, b)
 }
 
-/// The backward error from the product `ax` = Ax.
-fn backward_from_product(a: CscRef<'_>, ax: &[f64], x: &[f64], b: &[f64]) -> f64 {
+/// The backward error from the product `ax` = Ax and ‖A‖∞.
+fn backward_from_product(norm_a: f64, ax: &[f64], x: &[f64], b: &[f64]) -> f64 {
     let r = ax
         .iter()
         .zip(b)
         .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
-    let denom = norm_inf(a) * vector_norm_inf(x) + vector_norm_inf(b);
+    let denom = norm_a * vector_norm_inf(x) + vector_norm_inf(b);
     if denom > 0.0 {
         r / denom
     } else {
@@ -95,11 +95,17 @@ pub fn solve_checked(
     }
     let (mut relative, mut backward) = (0.0f64, 0.0f64);
     let mut ax = vec![0.0; a.nrows()];
+    let norm_a = norm_inf(a);
     for k in 0..nrhs {
         let cols = k * n..(k + 1) * n;
         a.mul_vec(&x[cols.clone()], &mut ax);
         relative = relative.max(relative_from_product(&ax, &b[cols.clone()]));
-        backward = backward.max(backward_from_product(a, &ax, &x[cols.clone()], &b[cols]));
+        backward = backward.max(backward_from_product(
+            norm_a,
+            &ax,
+            &x[cols.clone()],
+            &b[cols],
+        ));
     }
     Ok((
         x,
