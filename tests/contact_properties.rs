@@ -6,7 +6,7 @@
 use fibercell::cell::{CellGeometry, Periodicity};
 use fibercell::contact::{
     closest_points, find_candidates, find_candidates_brute_force, jump_operator, tangent_basis,
-    ContactPair, ContactSide, Friction,
+    BlockState, ContactPair, ContactSide, ContactState, Friction,
 };
 use fibercell::model::{FiberSpec, MaterialSpec, ModelDescription, NodeSpec};
 use fibercell::solve::{solve_incremental, solve_static, IncrementalOptions, SolveOptions};
@@ -141,6 +141,46 @@ proptest! {
             let expected = block(&pair, &sum);
             let got = DMatrix::from_fn(pair.size(), pair.size(), &k);
             prop_assert!((&got - &expected).amax() <= 1e-12 * expected.amax(), "stick {stick}");
+        }
+    }
+
+    /// G D Gᵀ from the block coefficients equals every block the incremental solver assembles
+    /// from the outer products: stick K_N + K_T^st + K_R; slip K_N + K_T^sl + K_R + k⊥ term
+    /// + ε K_T^st (Tresca and Coulomb); open ε (K_N + K_T^st + K_R); to rounding.
+    #[test]
+    fn block_coefficients_in_the_jump_basis_give_the_assembled_blocks(
+        a in point(), b in point(), c in point(), d in point(),
+        xi in prop::array::uniform2(0.0f64..1.0), normal in unit(),
+        dir in 0.0f64..std::f64::consts::TAU, k_perp in 0.0f64..1e5, eps in prop::sample::select(vec![0.0, 1e-8, 1e-3]),
+    ) {
+        prop_assume!((Vector3::from(b) - Vector3::from(a)).norm() > 0.1 && (Vector3::from(d) - Vector3::from(c)).norm() > 0.1);
+        let model = Model::from_description(&fibers(&[(a, b, 0.01), (c, d, 0.01)], 2)).unwrap();
+        let pair = pair_from(&model, xi, normal);
+        let direction = Vector2::new(dir.cos(), dir.sin());
+        let g = pair.jump_basis();
+        let m = pair.size();
+        let (kn, _) = pair.normal();
+        let (kt, _) = pair.stick(&Vector2::zeros());
+        let kr = pair.rotation();
+        for friction in [Friction::Tresca { bound: 0.3 }, Friction::Coulomb { mu: 0.4 }, Friction::None] {
+            for state in [ContactState::Stick, ContactState::Slip, ContactState::Open] {
+                let s = BlockState { state, direction, k_perp };
+                let coefficients = pair.block_coefficients(&s, friction, eps);
+                let got = DMatrix::from_fn(m, m, |r, c| {
+                    (0..6).map(|p| (0..6).map(|q| g[p][r] * coefficients[(p, q)] * g[q][c]).sum::<f64>()).sum::<f64>()
+                });
+                let expected = match state {
+                    ContactState::Stick => kn + kt + kr,
+                    ContactState::Open => (kn + kt + kr) * eps,
+                    ContactState::Slip => {
+                        let perp = pair.slip_perpendicular(&direction, k_perp, &Vector2::zeros()).0;
+                        kn + pair.slip(friction, &direction).0 + kr + perp + kt * eps
+                    }
+                };
+                let expected = block(&pair, &expected);
+                let scale = (kn + kt + kr).amax();
+                prop_assert!((&got - &expected).amax() <= 1e-12 * scale, "{friction:?} {state:?}");
+            }
         }
     }
 

@@ -305,8 +305,11 @@ fn coulomb_stick_then_slip_plateau_at_mu_n() {
         );
     }
     assert!(switched);
-    // Sliding under Coulomb friction is nonsymmetric: the LU backend was used.
-    assert_eq!(sol.increments.last().unwrap().backend, "faer-lu");
+    // Sliding under Coulomb friction is nonsymmetric: solved by LU, or on the symmetric stick
+    // factorization with the sliding contact as a nonsymmetric low-rank correction (chosen by
+    // measured cost).
+    let backend = &sol.increments.last().unwrap().backend;
+    assert!(backend == "faer-lu" || backend == "low-rank", "{backend}");
 }
 
 #[test]

@@ -2,12 +2,14 @@
 //! the contact points, normal and tangential contributions, and the contact set with its
 //! stick/slip states.
 
+mod coefficients;
 mod geometry;
 mod kinematics;
 mod law;
 mod search;
 mod set;
 
+pub use coefficients::{BlockCoefficients, BlockState};
 pub use geometry::{closest_points, ClosestPoints};
 pub use kinematics::{centerline_interpolation, jump_operator, ContactSide, Jump, JumpMatrix};
 pub use law::{

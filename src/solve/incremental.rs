@@ -11,10 +11,13 @@
 //! reported per increment.
 //!
 //! The pattern (elements ∪ all candidate contact blocks) and each backend's symbolic analysis are
-//! built once; a factorization is redone only when the assembled values changed. Systems with a
-//! Coulomb-sliding contact are nonsymmetric and go to LU, all others to the chosen symmetric
-//! backend.
+//! built once. The first symmetric factorization is the reference: later systems are its matrix
+//! plus the changed contacts' blocks, assembled as such and solved as a low-rank correction of
+//! it while that is cheaper than refactorizing (see [`IncrementalOptions::reuse_factor`]).
+//! Otherwise systems with a Coulomb-sliding contact are nonsymmetric and go to LU, all others
+//! to the chosen symmetric backend.
 
+use super::low_rank::{columns_needed, Capacitance, LowRankCorrection, SparseColumn};
 use super::static_solve::{backward_tolerance, check_backward_error, locate};
 use super::{check_supported_with, make_solver, IncrementTimings, SolveOptions, SolverKind};
 use crate::assembly::{
@@ -22,13 +25,14 @@ use crate::assembly::{
 };
 use crate::constraints::{internal_forces, Discretization, Reaction};
 use crate::contact::{
-    BlockMatrix, BlockVector, ContactPair, ContactSet, ContactSide, ContactState, Friction,
+    BlockCoefficients, BlockMatrix, BlockState, BlockVector, ContactPair, ContactSet, ContactSide,
+    ContactState, Friction,
 };
 use crate::model::Model;
 use crate::Error;
 use fibercell_solver::{
-    pcg_with_factor, relative_residual, solve_checked, AnalyzeInfo, LinearSolver, SolveInfo,
-    SolveReport, SolverError,
+    norm_inf, solve_checked, vector_norm_inf, CscRef, LinearSolver, SolveInfo, SolveReport,
+    SolverError,
 };
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use rayon::prelude::*;
@@ -74,13 +78,15 @@ pub struct IncrementalOptions {
     /// evolve, with a Coulomb bound μ max(N, 0). A model of bonded or consolidated mats, whose
     /// just-touching contacts would otherwise open under the smallest strain and chatter.
     pub bonded: bool,
-    /// After the blocks of a few contacts changed (at most 1 % of them: a state, a slip
-    /// direction or the tangent across it), solve by CG preconditioned with
-    /// the last symmetric factorization instead of refactorizing, within an iteration budget
-    /// worth half a factorization's measured time (a tenth of its flops until a factorization
-    /// and a CG iteration have been timed), refactorizing once ten budgets were spent on one
-    /// factorization; fall back to a factorization when CG does not reach a backward error 10⁵
-    /// times below the accepted one, as accurate as a direct solve (default true).
+    /// After the first factorization, solve on it: the contacts whose block changed since (a
+    /// state, a slip direction or the tangent across it) are a low-rank correction U E Uᵀ in
+    /// their jump rows, solved by the Sherman–Morrison–Woodbury formula with S = Uᵀ A₀⁻¹ U
+    /// kept across iterations and increments (see `low_rank.rs`), while its dense LU and two
+    /// solves are predicted cheaper than refactorizing (measured times); the result is
+    /// corrected with the residual of the assembled matrix until its backward error is 10⁵
+    /// times below the accepted one, as accurate as a direct solve, else the matrix is
+    /// refactorized and becomes the new reference (default true). Needs a direct symmetric
+    /// backend; Coulomb sliding (a nonsymmetric E) is solved on the symmetric factorization.
     pub reuse_factor: bool,
     /// Stop after the increment during which this instant passes (default: none); the solution
     /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
@@ -115,9 +121,10 @@ pub struct IncrementRecord {
     pub iterations: usize,
     /// Numeric factorizations done in this increment.
     pub factorizations: usize,
-    /// Solves done by CG preconditioned with an earlier factorization instead of a new one.
+    /// Solves done on an earlier factorization with the changed contacts as a low-rank
+    /// correction instead of a new factorization (see [`IncrementalOptions::reuse_factor`]).
     pub factor_reuses: usize,
-    /// CG iterations of those solves (and of attempts that fell back to a factorization).
+    /// Residual correction steps of those solves.
     pub reuse_iterations: usize,
     /// Contacts open, stuck and sliding at the end of the increment.
     pub open: usize,
@@ -370,44 +377,155 @@ fn stabilizer(pair: &ContactPair, state: ContactState) -> BlockMatrix {
     }
 }
 
-/// Contacts whose block differs between two assembled keys: a state (open, stick, slip), a
-/// slip direction or the tangent k⊥ across it. Each is a change of rank up to 3 that CG on the
-/// old factor needs iterations for; after a new increment every sliding contact's direction
-/// moved, and CG on hundreds of them fails its budget (measured on the M cell).
-fn differing_blocks(a: &AssembledKey, b: &AssembledKey) -> usize {
-    (0..a.1.len())
-        .filter(|&i| a.1[i] != b.1[i] || a.2[i] != b.2[i] || a.3[i] != b.3[i])
-        .count()
-}
+/// Columns of the low-rank correction kept on one factorization before refactorizing: S, their
+/// dense products, then takes 8 bytes × this squared (512 MB).
+const MAX_LOW_RANK_COLUMNS: usize = 8192;
 
-/// CG iterations preconditioned by a factorization that cost at most a tenth of refactorizing:
-/// one iteration is two triangular solves (4 nnz(L) flops) and a product with A (2 nnz(A)).
-fn reuse_iterations(info: &AnalyzeInfo) -> usize {
-    match (info.flops, info.nnz_factor) {
-        (Some(flops), Some(nnz_l)) => {
-            let per_iteration = 4.0 * nnz_l as f64 + 2.0 * info.nnz_a as f64;
-            ((0.1 * flops / per_iteration) as usize).clamp(4, 500)
-        }
-        _ => 20,
-    }
-}
+/// Correction steps x += W (b − A x) after a low-rank solve W ≈ A⁻¹ before it falls back to a
+/// factorization (the correction subtracts stick springs far stiffer than the fibers, which
+/// costs digits that one or two steps restore).
+const MAX_REFINEMENTS: usize = 3;
 
-/// What a factorization and one CG iteration on it cost, as measured in this run; the CG
-/// budget of a factor-reuse solve is half a factorization's time, or before both were measured
-/// the flops estimate of [`reuse_iterations`].
-struct ReuseCost {
-    estimate: usize,
+/// Later solves a new column of U is expected to serve: its cost (a solve with A₀ among many
+/// right-hand sides) is charged to the solve that adds it divided by this.
+const COLUMN_USES: f64 = 4.0;
+
+/// What a factorization, a solve, a new column of U and the dense LU cost in this run,
+/// measured: a low-rank solve (two solves with A₀, the new columns, the LU of order R) is done
+/// when predicted cheaper than refactorizing and solving.
+struct LowRankCost {
     factorize: Option<f64>,
-    per_iteration: Option<f64>,
+    solve: Option<f64>,
+    /// Seconds per new column, last measured (before: a quarter of a solve).
+    column: Option<f64>,
+    /// Flops per second of the capacitance LU (2/3 R³ flops), last measured.
+    lu_rate: f64,
 }
 
-impl ReuseCost {
-    fn budget(&self) -> usize {
-        match (self.factorize, self.per_iteration) {
-            (Some(f), Some(i)) if i > 0.0 => ((0.5 * f / i) as usize).min(500),
-            _ => self.estimate,
+impl LowRankCost {
+    fn worth(&self, order: usize, new: usize, columns: usize) -> bool {
+        let (Some(f), Some(s)) = (self.factorize, self.solve) else {
+            return false;
+        };
+        let lu = 2.0 / 3.0 * (order as f64).powi(3) / self.lu_rate;
+        let extend = new as f64 * self.column.unwrap_or(0.25 * s) / COLUMN_USES;
+        columns <= MAX_LOW_RANK_COLUMNS && lu + extend + 2.0 * s <= f + s
+    }
+}
+
+/// A low-rank solve that reached `tolerance`: the solution, its backward error, its relative
+/// residual ‖b − Ax‖₂/‖b‖₂ and the correction steps it took.
+struct LowRankSolve {
+    x: Vec<f64>,
+    backward_error: f64,
+    relative_residual: f64,
+    refinements: usize,
+}
+
+/// ‖A‖∞ of a symmetric A stored in full: its largest column sum, column by column in parallel.
+fn norm_inf_symmetric(a: CscRef<'_>) -> f64 {
+    (0..a.ncols())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|j| a.col(j).1.iter().map(|v| v.abs()).sum::<f64>())
+        .reduce(|| 0.0, f64::max)
+}
+
+/// Solves A x = b by the low-rank correction `cap` of the reference factorization `a0`, then
+/// corrects x with the residual of the assembled `a` until the backward error is at most
+/// `tolerance`; `None` when [`MAX_REFINEMENTS`] steps do not get there (or the capacitance
+/// matrix is singular).
+fn low_rank_solve(
+    low_rank: &LowRankCorrection,
+    a0: &mut dyn LinearSolver,
+    cap: &Capacitance,
+    a: CscRef<'_>,
+    symmetric: bool,
+    b: &[f64],
+    tolerance: f64,
+) -> Result<Option<LowRankSolve>, SolverError> {
+    let Ok(mut x) = low_rank.solve(a0, cap, b) else {
+        return Ok(None);
+    };
+    let norm_a = if symmetric {
+        norm_inf_symmetric(a)
+    } else {
+        norm_inf(a)
+    };
+    let norm_b = vector_norm_inf(b);
+    let mut ax = vec![0.0; b.len()];
+    for refinements in 0..=MAX_REFINEMENTS {
+        if symmetric {
+            a.mul_vec_symmetric_par(&x, &mut ax);
+        } else {
+            a.mul_vec(&x, &mut ax);
+        }
+        let r: Vec<f64> = b.iter().zip(&ax).map(|(p, q)| p - q).collect();
+        let denom = norm_a * vector_norm_inf(&x) + norm_b;
+        let backward_error = if denom > 0.0 {
+            vector_norm_inf(&r) / denom
+        } else {
+            vector_norm_inf(&r)
+        };
+        if !backward_error.is_finite() {
+            return Ok(None);
+        }
+        if backward_error <= tolerance {
+            let two = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let nb = two(b);
+            return Ok(Some(LowRankSolve {
+                relative_residual: if nb > 0.0 { two(&r) / nb } else { two(&r) },
+                x,
+                backward_error,
+                refinements,
+            }));
+        }
+        if refinements == MAX_REFINEMENTS {
+            break;
+        }
+        let Ok(dx) = low_rank.solve(a0, cap, &r) else {
+            return Ok(None);
+        };
+        x.iter_mut().zip(&dx).for_each(|(xi, d)| *xi += d);
+    }
+    Ok(None)
+}
+
+/// Adds G ΔD Gᵀ, the change `e` of `pair`'s block coefficients, to its slots in `values`.
+fn add_block_change(pair: &ContactPair, slots: &[u32], e: &BlockCoefficients, values: &mut [f64]) {
+    let g = pair.jump_basis();
+    let m = pair.size();
+    for r in 0..m {
+        let ge: [f64; 6] = std::array::from_fn(|b| (0..6).map(|a| g[a][r] * e[(a, b)]).sum());
+        for c in 0..m {
+            let s = slots[r * m + c];
+            if s != NO_SLOT {
+                values[s as usize] += (0..6).map(|b| ge[b] * g[b][c]).sum::<f64>();
+            }
         }
     }
+}
+
+/// The column of U for basis row `k` of `pair`'s jump basis in the free DOFs.
+fn low_rank_column(pair: &ContactPair, disc: &Discretization, k: usize) -> SparseColumn {
+    let g = pair.jump_basis()[k];
+    let mut col: SparseColumn = (0..pair.size())
+        .filter_map(|r| {
+            let gdof = 6 * pair.jump.nodes[r / 6] + r % 6;
+            disc.reduced(gdof).map(|i| (i, g[r]))
+        })
+        .collect();
+    col.sort_unstable_by_key(|e| e.0);
+    col.dedup_by(|b, a| {
+        if a.0 == b.0 {
+            a.1 += b.1;
+            true
+        } else {
+            false
+        }
+    });
+    col.retain(|e| e.1 != 0.0);
+    col
 }
 
 /// What an assembled matrix was built from: symmetry, states, slip directions, k⊥ of each contact.
@@ -715,14 +833,34 @@ pub(crate) fn run_incremental(
     }
     let mut dissipated = 0.0;
     // CG iterations preconditioned by the previous factorization allowed per solve (0: none).
-    let mut reuse_cost = ReuseCost {
-        estimate: 0,
+    let mut low_rank_cost = LowRankCost {
         factorize: None,
-        per_iteration: None,
+        solve: None,
+        column: None,
+        lu_rate: 1e10,
     };
-    // CG iterations spent on the current factorization: once they add up to about one
-    // factorization, refactorize.
-    let mut spent_since_factor = 0;
+    // The block coefficients of every contact in the last symmetric factorization (the
+    // reference A₀ of the low-rank solves), and the correction accumulated on it.
+    let mut reference: Option<Vec<BlockCoefficients>> = None;
+    let mut low_rank = LowRankCorrection::new(n_free, pairs.len());
+    let mut reference_values = vec![0.0; pattern.nnz()];
+    // Per contact, its block columns on prescribed DOFs (their products go to the load).
+    let prescribed: Vec<Vec<usize>> = pairs
+        .iter()
+        .map(|p| {
+            (0..p.size())
+                .filter(|&c| disc.reduced(6 * p.jump.nodes[c / 6] + c % 6).is_none())
+                .collect()
+        })
+        .collect();
+    let block_state = |states: &[ContactState],
+                       directions: &[Vector2<f64>],
+                       perpendicular: &[(f64, Vector2<f64>)],
+                       i: usize| BlockState {
+        state: states[i],
+        direction: directions[i],
+        k_perp: perpendicular[i].0,
+    };
     for (step, &alpha) in (1..).zip(&path) {
         let increment_start = std::time::Instant::now();
         let mut factorizations = 0;
@@ -735,8 +873,31 @@ pub(crate) fn run_incremental(
         let lap = IncrementTimings::lap;
         let mut clock = increment_start;
         for iteration in 1..=opts.max_state_iterations {
-            // Assemble K + K_N + K_T and α F + F_N + F_T for the current states.
-            values.copy_from_slice(&k_elastic);
+            // Assemble K + K_N + K_T and α F + F_N + F_T for the current states: once a
+            // symmetric factorization is the reference, its values plus the blocks of the
+            // contacts that changed since (G ΔD Gᵀ), else element and contact blocks anew.
+            let changes: Option<Vec<(usize, BlockCoefficients)>> =
+                reference.as_ref().map(|reference| {
+                    (0..pairs.len())
+                        .filter_map(|i| {
+                            let e = pairs[i].block_coefficients(
+                                &block_state(&states, &directions, &perpendicular, i),
+                                friction,
+                                stabilization,
+                            ) - reference[i];
+                            (columns_needed(&e) > 0).then_some((i, e))
+                        })
+                        .collect()
+                });
+            if let Some(changes) = &changes {
+                values.copy_from_slice(&reference_values);
+                for (i, e) in changes {
+                    add_block_change(&pairs[*i], pattern.extra_slots(*i), e, &mut values);
+                }
+            } else {
+                values.copy_from_slice(&k_elastic);
+            }
+            let write_values = changes.is_none();
             let mut rhs: Vec<f64> = rhs_full.iter().map(|v| alpha * v).collect();
             let closed: Vec<&[usize]> = (0..pairs.len())
                 .filter(|&i| states[i] != ContactState::Open)
@@ -786,14 +947,17 @@ pub(crate) fn run_incremental(
                                 // this color holds, and so are the slots of row r.
                                 let rhs_r = unsafe { shared_rhs.get(ir) };
                                 *rhs_r += f[r];
-                                for c in 0..m {
-                                    let s = slots[r * m + c];
-                                    if s != NO_SLOT {
-                                        // SAFETY: as above.
-                                        unsafe { *shared_values.get(s as usize) += k(r, c) };
-                                    } else if disc.reduced(gdof(c)).is_none() {
-                                        *rhs_r -= k(r, c) * alpha * disc.prescribed_value(gdof(c));
+                                if write_values {
+                                    for c in 0..m {
+                                        let s = slots[r * m + c];
+                                        if s != NO_SLOT {
+                                            // SAFETY: as above.
+                                            unsafe { *shared_values.get(s as usize) += k(r, c) };
+                                        }
                                     }
+                                }
+                                for &c in &prescribed[i] {
+                                    *rhs_r -= k(r, c) * alpha * disc.prescribed_value(gdof(c));
                                 }
                             }
                         };
@@ -821,87 +985,104 @@ pub(crate) fn run_incremental(
             }
             let a = pattern.matrix(&values)?;
             lap(&mut timings.assemble, &mut clock);
-            let (slot, kind) = if nonsymmetric {
-                (&mut backends.general, SolverKind::FaerLu)
-            } else {
-                (&mut backends.symmetric, opts.solve.solver)
-            };
-            if slot.is_none() {
-                let mut s = make_solver(kind, &opts.solve.ordering, disc.node_block_starts())?;
-                let info = s.analyze(a).map_err(locate)?;
-                if !nonsymmetric && !s.capabilities().iterative {
-                    reuse_cost.estimate = reuse_iterations(&info);
-                }
-                *slot = Some(s);
-            }
-            let solver = slot
-                .as_mut()
-                .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "analyze")))?;
-            let key = (
-                nonsymmetric,
-                states.clone(),
-                directions.clone(),
-                perpendicular.iter().map(|p| p.0).collect::<Vec<f64>>(),
-            );
-            // A symmetric factorization of nearby values preconditions CG on the new ones
-            // when few contacts changed since it was computed (each change is a low-rank
-            // update); otherwise, or when CG does not converge within its budget, refactorize.
-            lap(&mut timings.factorize, &mut clock);
+            // After the first factorization, solve on it with the changed contacts as a low-rank
+            // correction while that is cheaper than refactorizing (see LowRankCost).
             let mut reused = None;
-            let reuse_budget = reuse_cost.budget();
-            if let Some(old) = factorized.as_ref().filter(|_| n_free > 0) {
-                if opts.reuse_factor
-                    && !nonsymmetric
-                    && !old.0
-                    && *old != key
-                    && reuse_budget > 0
-                    && differing_blocks(old, &key) <= (pairs.len() / 100).max(1)
-                    && spent_since_factor < 10 * reuse_budget
-                {
-                    let tol = REUSE_ACCURACY * backward_tolerance(&opts.solve);
+            if let (Some(changes), Some(a0), true) = (
+                changes.as_ref(),
+                backends.symmetric.as_mut(),
+                opts.reuse_factor && n_free > 0,
+            ) {
+                let (order, new) = low_rank.size_of(changes);
+                if low_rank_cost.worth(order, new, low_rank.len() + new) {
                     let started = std::time::Instant::now();
-                    let r = pcg_with_factor(solver.as_mut(), a, &rhs, tol, reuse_budget)
+                    low_rank
+                        .extend(a0.as_mut(), changes, |c, k| {
+                            low_rank_column(&pairs[c], disc, k)
+                        })
                         .map_err(locate)?;
-                    if r.iterations > 0 {
-                        reuse_cost.per_iteration =
-                            Some(started.elapsed().as_secs_f64() / r.iterations as f64);
+                    if new > 0 {
+                        low_rank_cost.column = Some(started.elapsed().as_secs_f64() / new as f64);
                     }
-                    reuse_iterations_done += r.iterations;
-                    spent_since_factor += r.iterations.max(1);
-                    if r.converged {
-                        reused = Some(r);
+                    let started = std::time::Instant::now();
+                    let cap = low_rank.capacitance(changes);
+                    if order > 0 {
+                        low_rank_cost.lu_rate = (2.0 / 3.0 * (order as f64).powi(3)
+                            / started.elapsed().as_secs_f64().max(1e-9))
+                        .max(1e8);
                     }
+                    let tol = REUSE_ACCURACY * backward_tolerance(&opts.solve);
+                    reused =
+                        low_rank_solve(&low_rank, a0.as_mut(), &cap, a, !nonsymmetric, &rhs, tol)
+                            .map_err(locate)?;
                     lap(&mut timings.factor_reuse, &mut clock);
                 }
             }
             let (x, report) = if let Some(r) = reused {
                 factor_reuses += 1;
+                reuse_iterations_done += r.refinements;
                 let report = SolveReport {
-                    backend: "factor-pcg",
-                    relative_residual: relative_residual(a, &r.x, &rhs),
+                    backend: "low-rank",
+                    relative_residual: r.relative_residual,
                     backward_error: r.backward_error,
                     info: SolveInfo {
-                        iterations: Some(r.iterations),
+                        iterations: Some(r.refinements),
                         ..SolveInfo::default()
                     },
                 };
                 (r.x, Some(report))
             } else {
+                let (slot, kind) = if nonsymmetric {
+                    (&mut backends.general, SolverKind::FaerLu)
+                } else {
+                    (&mut backends.symmetric, opts.solve.solver)
+                };
+                if slot.is_none() {
+                    let mut s = make_solver(kind, &opts.solve.ordering, disc.node_block_starts())?;
+                    s.analyze(a).map_err(locate)?;
+                    *slot = Some(s);
+                }
+                let solver = slot
+                    .as_mut()
+                    .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "analyze")))?;
+                let key = (
+                    nonsymmetric,
+                    states.clone(),
+                    directions.clone(),
+                    perpendicular.iter().map(|p| p.0).collect::<Vec<f64>>(),
+                );
+                lap(&mut timings.factorize, &mut clock);
                 if factorized.as_ref() != Some(&key) {
                     let started = std::time::Instant::now();
                     solver.factorize(a).map_err(locate)?;
-                    if !nonsymmetric {
-                        reuse_cost.factorize = Some(started.elapsed().as_secs_f64());
-                    }
                     factorizations += 1;
                     factorized = Some(key);
-                    spent_since_factor = 0;
+                    if !nonsymmetric && !solver.capabilities().iterative {
+                        low_rank_cost.factorize = Some(started.elapsed().as_secs_f64());
+                        reference = Some(
+                            (0..pairs.len())
+                                .map(|i| {
+                                    pairs[i].block_coefficients(
+                                        &block_state(&states, &directions, &perpendicular, i),
+                                        friction,
+                                        stabilization,
+                                    )
+                                })
+                                .collect(),
+                        );
+                        reference_values.copy_from_slice(&values);
+                        low_rank.reset();
+                    }
                     lap(&mut timings.factorize, &mut clock);
                 }
                 if n_free == 0 {
                     (Vec::new(), None)
                 } else {
+                    let started = std::time::Instant::now();
                     let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1).map_err(locate)?;
+                    if !nonsymmetric {
+                        low_rank_cost.solve = Some(started.elapsed().as_secs_f64());
+                    }
                     (x, Some(r))
                 }
             };

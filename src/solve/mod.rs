@@ -4,6 +4,7 @@ mod backend;
 mod connectivity;
 mod increment_timings;
 mod incremental;
+mod low_rank;
 mod reduced;
 mod static_solve;
 

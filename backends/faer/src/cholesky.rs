@@ -284,15 +284,40 @@ impl LinearSolver for FaerCholesky {
         for col in rhs.chunks_mut(n) {
             col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
         }
-        let req = an.symbolic.solve_in_place_scratch::<f64>(nrhs, self.par);
-        let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
-        let stack = MemStack::new(&mut buf);
-        let mat = MatMut::from_column_major_slice_mut(rhs, n, nrhs);
-        match self.variant {
-            CholeskyVariant::Llt => LltRef::new(&an.symbolic, &f.l_values)
-                .solve_in_place_with_conj(Conj::No, mat, self.par, stack),
-            CholeskyVariant::Ldlt => LdltRef::new(&an.symbolic, &f.l_values)
-                .solve_in_place_with_conj(Conj::No, mat, self.par, stack),
+        // Several right-hand sides: column groups solved side by side, one per thread (faer's
+        // supernodal solve gains little from more columns at a time or from a parallel kernel).
+        let threads = match self.par {
+            Par::Seq => 1,
+            Par::Rayon(t) => t.get(),
+        };
+        let groups = threads.min(nrhs).max(1);
+        let (par, per_group) = if groups > 1 {
+            (Par::Seq, nrhs.div_ceil(groups))
+        } else {
+            (self.par, nrhs)
+        };
+        let variant = self.variant;
+        let solve_group = |block: &mut [f64]| -> Result<(), SolverError> {
+            let k = block.len() / n;
+            let req = an.symbolic.solve_in_place_scratch::<f64>(k, par);
+            let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
+            let stack = MemStack::new(&mut buf);
+            let mat = MatMut::from_column_major_slice_mut(block, n, k);
+            match variant {
+                CholeskyVariant::Llt => LltRef::new(&an.symbolic, &f.l_values)
+                    .solve_in_place_with_conj(Conj::No, mat, par, stack),
+                CholeskyVariant::Ldlt => LdltRef::new(&an.symbolic, &f.l_values)
+                    .solve_in_place_with_conj(Conj::No, mat, par, stack),
+            }
+            Ok(())
+        };
+        if groups > 1 {
+            use rayon::prelude::*;
+            rhs.par_chunks_mut(per_group * n)
+                .map(solve_group)
+                .collect::<Result<Vec<()>, SolverError>>()?;
+        } else {
+            solve_group(rhs)?;
         }
         for col in rhs.chunks_mut(n) {
             col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);

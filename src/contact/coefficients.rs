@@ -1,0 +1,85 @@
+//! A contact block in the basis of its jump rows: every block the incremental solver assembles
+//! (K_N 4.53, K_T^st 4.58, K_T^sl, the consistent tangent k⊥, K_R and the stabilizing springs)
+//! is G D Gᵀ with G = [Bᵀn, Bᵀt₁, Bᵀt₂, Rᵀe₁, Rᵀe₂, Rᵀe₃] the contact's six jump rows and D a
+//! 6 × 6 coefficient matrix. A change of state or slip direction changes D only, so it is a
+//! change of rank ≤ 6 (2 between stick and slip) in a basis fixed for the whole analysis.
+
+use super::law::{BlockVector, ContactPair, ContactState, Friction};
+use nalgebra::{SMatrix, Vector2, Vector3};
+
+/// The 6 × 6 coefficients D of a contact block G D Gᵀ, in the order normal, the two tangents,
+/// the three rotation components.
+pub type BlockCoefficients = SMatrix<f64, 6, 6>;
+
+/// What a contact's block depends on in the incremental solver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlockState {
+    /// Open, stick or slip.
+    pub state: ContactState,
+    /// Unit slip direction in the tangent basis (used when sliding).
+    pub direction: Vector2<f64>,
+    /// The consistent tangent k⊥ across the slip direction (0: none).
+    pub k_perp: f64,
+}
+
+impl ContactPair {
+    /// The basis G: Bᵀn, Bᵀt₁, Bᵀt₂, Rᵀe₁, Rᵀe₂, Rᵀe₃ (block DOFs, padded to 30).
+    pub fn jump_basis(&self) -> [BlockVector; 6] {
+        let b = self.jump.b.transpose();
+        let r = self.jump.r.transpose();
+        [
+            b * self.normal,
+            b * self.tangents[0],
+            b * self.tangents[1],
+            r * Vector3::x(),
+            r * Vector3::y(),
+            r * Vector3::z(),
+        ]
+    }
+
+    /// The coefficients D of the block the incremental solver assembles for `s`, with friction
+    /// `friction` and stabilization ε: stick p_N, p_T, p_T, p_R ×3 on the diagonal; open ε times
+    /// that; slip p_N, ε p_T (+ k⊥ p pᵀ across the direction, p = (−d₂, d₁)), p_R ×3, and for
+    /// Coulomb μ p_N d in the tangential rows of the normal column (K_T^sl = μ p_N Bᵀd nᵀB).
+    pub fn block_coefficients(
+        &self,
+        s: &BlockState,
+        friction: Friction,
+        stabilization: f64,
+    ) -> BlockCoefficients {
+        let (pn, pt, pr) = (
+            self.penalty_normal,
+            self.penalty_tangent,
+            self.penalty_rotation,
+        );
+        let stick =
+            BlockCoefficients::from_diagonal(&nalgebra::Vector6::new(pn, pt, pt, pr, pr, pr));
+        match s.state {
+            ContactState::Stick => stick,
+            ContactState::Open => stick * stabilization,
+            ContactState::Slip => {
+                let mut d = BlockCoefficients::from_diagonal(&nalgebra::Vector6::new(
+                    pn,
+                    stabilization * pt,
+                    stabilization * pt,
+                    pr,
+                    pr,
+                    pr,
+                ));
+                if let Friction::Coulomb { mu } = friction {
+                    d[(1, 0)] += mu * pn * s.direction[0];
+                    d[(2, 0)] += mu * pn * s.direction[1];
+                }
+                if s.k_perp > 0.0 {
+                    let p = Vector2::new(-s.direction[1], s.direction[0]);
+                    for a in 0..2 {
+                        for b in 0..2 {
+                            d[(1 + a, 1 + b)] += s.k_perp * p[a] * p[b];
+                        }
+                    }
+                }
+                d
+            }
+        }
+    }
+}

@@ -1,0 +1,354 @@
+//! Solves after contact changes on one fixed factorization (Sherman–Morrison–Woodbury).
+//!
+//! With A₀ the factorized matrix, a contact whose block coefficients changed by ΔD_c adds
+//! U_c ΔD_c U_cᵀ, U_c its jump rows in the free DOFs (see
+//! [`ContactPair::jump_basis`](crate::contact::ContactPair)); all changes together are
+//! A = A₀ + U E Uᵀ with E block diagonal, and
+//!
+//! x = A₀⁻¹ b − A₀⁻¹ U z,  (I + E S) z = E Uᵀ A₀⁻¹ b,  S = Uᵀ A₀⁻¹ U:
+//!
+//! two solves with A₀ and one dense LU of order R (the changed contacts' columns). S is kept:
+//! a contact's columns are solved for once (many right-hand sides at a time) and serve every
+//! later solve on the same A₀, whatever its state or slip direction then. E may be
+//! nonsymmetric (Coulomb sliding) while A₀ is a symmetric factorization.
+
+use crate::contact::BlockCoefficients;
+use faer::linalg::solvers::{PartialPivLu, Solve};
+use faer::{Mat, MatMut, MatRef};
+use fibercell_solver::{LinearSolver, SolverError};
+use rayon::prelude::*;
+
+/// The order in which a contact's jump rows become columns of U: the two tangents first (all a
+/// switch between stick and slip or a new slip direction needs), then the normal (Coulomb
+/// sliding, opening), then the three rotations.
+const ORDER: [usize; 6] = [1, 2, 0, 3, 4, 5];
+
+/// Bytes of right-hand sides solved for at once when columns are added.
+const BATCH_BYTES: usize = 256 << 20;
+
+/// How many leading entries of the column order a coefficient change `e` needs (0: none).
+pub(crate) fn columns_needed(e: &BlockCoefficients) -> usize {
+    let touches = |i: usize| (0..6).any(|j| e[(i, j)] != 0.0 || e[(j, i)] != 0.0);
+    if (3..6).any(touches) {
+        6
+    } else if touches(0) {
+        3
+    } else if touches(1) || touches(2) {
+        2
+    } else {
+        0
+    }
+}
+
+/// A sparse column of U: (free DOF, value), DOFs distinct.
+pub(crate) type SparseColumn = Vec<(usize, f64)>;
+
+fn dot(column: &SparseColumn, x: &[f64]) -> f64 {
+    column.iter().map(|&(i, v)| v * x[i]).sum()
+}
+
+/// The columns U and S = Uᵀ A₀⁻¹ U accumulated on one factorization A₀.
+pub(crate) struct LowRankCorrection {
+    n: usize,
+    columns: Vec<SparseColumn>,
+    /// Per contact: indices of its columns, in [`ORDER`].
+    owned: Vec<Vec<usize>>,
+    /// S = Uᵀ A₀⁻¹ U (order `columns.len()`).
+    s: Mat<f64>,
+}
+
+/// The factorized capacitance matrix I + E S of one set of changes.
+pub(crate) struct Capacitance {
+    /// Per changed contact: its columns and its E (row-major, in column order).
+    blocks: Vec<(Vec<usize>, Vec<f64>)>,
+    /// The changed contacts' columns, block after block.
+    active: Vec<usize>,
+    lu: PartialPivLu<f64>,
+}
+
+impl Capacitance {
+    /// Its order R.
+    pub(crate) fn order(&self) -> usize {
+        self.active.len()
+    }
+}
+
+impl LowRankCorrection {
+    /// No columns, for `contacts` contacts and `n` free DOFs.
+    pub(crate) fn new(n: usize, contacts: usize) -> Self {
+        LowRankCorrection {
+            n,
+            columns: Vec::new(),
+            owned: vec![Vec::new(); contacts],
+            s: Mat::zeros(0, 0),
+        }
+    }
+
+    /// Forgets all columns (A₀ was refactorized).
+    pub(crate) fn reset(&mut self) {
+        self.columns.clear();
+        self.owned.iter_mut().for_each(Vec::clear);
+        self.s = Mat::zeros(0, 0);
+    }
+
+    /// Columns of U so far.
+    pub(crate) fn len(&self) -> usize {
+        self.columns.len()
+    }
+
+    /// The order of the capacitance matrix of `changes` and how many of its columns are new.
+    pub(crate) fn size_of(&self, changes: &[(usize, BlockCoefficients)]) -> (usize, usize) {
+        changes.iter().fold((0, 0), |(order, new), (c, e)| {
+            let have = self.owned[*c].len();
+            let need = columns_needed(e).max(have);
+            (order + need, new + need - have)
+        })
+    }
+
+    /// Adds the columns `changes` need, `column(contact, basis row)` giving one (basis rows as
+    /// in [`BlockCoefficients`]), and extends S by solving with the factorization `a0`.
+    pub(crate) fn extend(
+        &mut self,
+        a0: &mut dyn LinearSolver,
+        changes: &[(usize, BlockCoefficients)],
+        column: impl Fn(usize, usize) -> SparseColumn + Sync,
+    ) -> Result<(), SolverError> {
+        let first = self.columns.len();
+        let wanted: Vec<(usize, usize)> = changes
+            .iter()
+            .flat_map(|(c, e)| {
+                let have = self.owned[*c].len();
+                (have..columns_needed(e).max(have)).map(move |k| (*c, ORDER[k]))
+            })
+            .collect();
+        if wanted.is_empty() {
+            return Ok(());
+        }
+        let new: Vec<SparseColumn> = wanted.par_iter().map(|&(c, k)| column(c, k)).collect();
+        for (j, &(c, _)) in wanted.iter().enumerate() {
+            self.owned[c].push(first + j);
+        }
+        self.columns.extend(new);
+        let total = self.columns.len();
+        let n = self.n;
+        self.s.resize_with(total, total, |_, _| 0.0);
+        let batch = (BATCH_BYTES / (8 * n.max(1))).clamp(1, 256);
+        for start in (first..total).step_by(batch) {
+            let end = (start + batch).min(total);
+            let k = end - start;
+            let mut z = vec![0.0; n * k];
+            for (j, col) in self.columns[start..end].iter().enumerate() {
+                for &(i, v) in col {
+                    z[j * n + i] += v;
+                }
+            }
+            a0.solve_in_place(&mut z, k)?;
+            let columns = &self.columns;
+            let products: Vec<Vec<f64>> = z
+                .par_chunks(n)
+                .map(|zj| columns.iter().map(|u| dot(u, zj)).collect())
+                .collect();
+            for (j, p) in products.iter().enumerate() {
+                let c = start + j;
+                for (row, &v) in p.iter().enumerate() {
+                    self.s[(row, c)] = v;
+                    if row < start {
+                        // S is symmetric for a symmetric A₀.
+                        self.s[(c, row)] = v;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Factorizes I + E S for `changes` (each contact's columns must be there: see
+    /// [`LowRankCorrection::extend`]).
+    pub(crate) fn capacitance(&self, changes: &[(usize, BlockCoefficients)]) -> Capacitance {
+        let blocks: Vec<(Vec<usize>, Vec<f64>)> = changes
+            .iter()
+            .map(|(c, e)| {
+                let cols = self.owned[*c].clone();
+                let k = cols.len();
+                let mut block = vec![0.0; k * k];
+                for i in 0..k {
+                    for l in 0..k {
+                        block[i * k + l] = e[(ORDER[i], ORDER[l])];
+                    }
+                }
+                (cols, block)
+            })
+            .collect();
+        let active: Vec<usize> = blocks.iter().flat_map(|(c, _)| c.clone()).collect();
+        let r = active.len();
+        let mut data = vec![0.0; r * r];
+        data.par_chunks_mut(r.max(1))
+            .zip(&active)
+            .enumerate()
+            .for_each(|(j, (out, &col))| {
+                let mut offset = 0;
+                for (cols, e) in &blocks {
+                    let k = cols.len();
+                    for i in 0..k {
+                        out[offset + i] =
+                            (0..k).map(|l| e[i * k + l] * self.s[(cols[l], col)]).sum();
+                    }
+                    offset += k;
+                }
+                out[j] += 1.0;
+            });
+        let lu = MatRef::from_column_major_slice(&data, r, r).partial_piv_lu();
+        Capacitance { blocks, active, lu }
+    }
+
+    /// x = (A₀ + U E Uᵀ)⁻¹ b for the changes factorized in `cap`, `a0` the factorization of A₀.
+    pub(crate) fn solve(
+        &self,
+        a0: &mut dyn LinearSolver,
+        cap: &Capacitance,
+        b: &[f64],
+    ) -> Result<Vec<f64>, SolverError> {
+        let mut x = b.to_vec();
+        a0.solve_in_place(&mut x, 1)?;
+        let mut z = Vec::with_capacity(cap.order());
+        for (cols, e) in &cap.blocks {
+            let k = cols.len();
+            let u: Vec<f64> = cols.iter().map(|&c| dot(&self.columns[c], &x)).collect();
+            z.extend((0..k).map(|i| (0..k).map(|l| e[i * k + l] * u[l]).sum::<f64>()));
+        }
+        let r = z.len();
+        cap.lu
+            .solve_in_place(MatMut::from_column_major_slice_mut(&mut z, r, 1));
+        if let Some(i) = z.iter().position(|v| !v.is_finite()) {
+            return Err(SolverError::NonFinite {
+                what: "capacitance solution",
+                index: i,
+            });
+        }
+        let mut w = vec![0.0; self.n];
+        for (&col, zj) in cap.active.iter().zip(&z) {
+            for &(i, v) in &self.columns[col] {
+                w[i] += v * zj;
+            }
+        }
+        a0.solve_in_place(&mut w, 1)?;
+        x.iter_mut().zip(&w).for_each(|(xi, wi)| *xi -= wi);
+        Ok(x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::{make_solver, SolverKind};
+    use fibercell_solver::{CscMatrix, Ordering};
+    use nalgebra::{DMatrix, DVector};
+
+    /// The Woodbury solve equals a dense solve of A₀ + U E Uᵀ (a path-graph Laplacian plus a
+    /// diagonal as A₀, contacts of 2, 3 and 6 columns on random DOFs, E nonsymmetric and
+    /// indefinite as a stick → slip change is) to 1e-10, and S grown in two steps equals
+    /// Uᵀ A₀⁻¹ U computed at once.
+    #[test]
+    fn woodbury_solve_matches_a_dense_solve_of_the_modified_matrix() {
+        let n = 60;
+        let mut triplets = Vec::new();
+        for i in 0..n {
+            triplets.push((i, i, 3.0 + (i % 7) as f64 * 0.1));
+            if i + 1 < n {
+                triplets.push((i, i + 1, -1.0));
+                triplets.push((i + 1, i, -1.0));
+            }
+        }
+        let a0 = CscMatrix::from_triplets(n, n, &triplets).expect("matrix");
+        let mut solver =
+            make_solver(SolverKind::FaerCholesky, &Ordering::Auto, Vec::new()).expect("solver");
+        solver.analyze(a0.as_ref()).expect("analyze");
+        solver.factorize(a0.as_ref()).expect("factorize");
+        // A pseudo-random but fixed column for (contact, basis row).
+        let column = |c: usize, k: usize| -> SparseColumn {
+            (0..4)
+                .map(|j| {
+                    (
+                        (7 * c + 13 * k + 17 * j) % n,
+                        1.0 + ((c + k + j) % 5) as f64 * 0.3,
+                    )
+                })
+                .fold(Vec::<(usize, f64)>::new(), |mut v, (i, x)| {
+                    match v.iter_mut().find(|e| e.0 == i) {
+                        Some(e) => e.1 += x,
+                        None => v.push((i, x)),
+                    }
+                    v
+                })
+        };
+        let change = |c: usize, level: usize| {
+            let mut e = BlockCoefficients::zeros();
+            for &i in &ORDER[..level] {
+                for &j in &ORDER[..level] {
+                    e[(i, j)] = 0.2 * ((3 * i + 5 * j + c) % 7) as f64 - 0.6;
+                }
+            }
+            e
+        };
+        let mut low_rank = LowRankCorrection::new(n, 4);
+        let first = vec![(0, change(0, 2)), (2, change(2, 3))];
+        low_rank
+            .extend(solver.as_mut(), &first, column)
+            .expect("extend");
+        let changes = vec![(0, change(0, 2)), (1, change(1, 6)), (2, change(2, 3))];
+        assert_eq!(low_rank.size_of(&changes), (11, 6));
+        low_rank
+            .extend(solver.as_mut(), &changes, column)
+            .expect("extend");
+        assert_eq!(low_rank.len(), 11);
+        // Dense A = A₀ + Σ U_c E_c U_cᵀ.
+        let mut dense = DMatrix::<f64>::zeros(n, n);
+        for &(i, j, v) in &triplets {
+            dense[(i, j)] += v;
+        }
+        let basis = |c: usize, k: usize| {
+            let mut v = DVector::<f64>::zeros(n);
+            for (i, x) in column(c, k) {
+                v[i] += x;
+            }
+            v
+        };
+        for (c, e) in &changes {
+            for p in 0..6 {
+                for q in 0..6 {
+                    if e[(p, q)] != 0.0 {
+                        dense += basis(*c, p) * basis(*c, q).transpose() * e[(p, q)];
+                    }
+                }
+            }
+        }
+        // S against Uᵀ A₀⁻¹ U.
+        let a0_dense = DMatrix::from_fn(n, n, |i, j| {
+            triplets
+                .iter()
+                .filter(|t| t.0 == i && t.1 == j)
+                .map(|t| t.2)
+                .sum::<f64>()
+        });
+        let inv = a0_dense.try_inverse().expect("invertible");
+        let owned: Vec<(usize, usize)> = [(0, 2), (2, 3), (1, 6)]
+            .iter()
+            .flat_map(|&(c, l)| ORDER[..l].iter().map(move |&k| (c, k)))
+            .collect();
+        for (r, &(c1, k1)) in owned.iter().enumerate() {
+            for (s, &(c2, k2)) in owned.iter().enumerate() {
+                let expected = (basis(c1, k1).transpose() * &inv * basis(c2, k2))[(0, 0)];
+                assert!((low_rank.s[(r, s)] - expected).abs() <= 1e-12 * expected.abs().max(1.0));
+            }
+        }
+        let b: Vec<f64> = (0..n).map(|i| ((i * 31) % 11) as f64 - 5.0).collect();
+        let cap = low_rank.capacitance(&changes);
+        let x = low_rank.solve(solver.as_mut(), &cap, &b).expect("solve");
+        let expected = dense
+            .lu()
+            .solve(&DVector::from_vec(b))
+            .expect("nonsingular");
+        let err = (DVector::from_vec(x) - &expected).amax() / expected.amax();
+        assert!(err <= 1e-10, "relative error {err}");
+    }
+}
