@@ -180,6 +180,22 @@ proptest! {
                 let expected = block(&pair, &expected);
                 let scale = (kn + kt + kr).amax();
                 prop_assert!((&got - &expected).amax() <= 1e-12 * scale, "{friction:?} {state:?}");
+                // And the load G φ against the blocks' loads.
+                let anchor = Vector2::new(xi[1] - 0.3, 0.1 - xi[0]) * 1e-3;
+                let slip = Vector2::new(2e-4, -1e-4);
+                let phi = pair.load_coefficients(&s, &anchor, &slip, friction);
+                let load: fibercell::contact::BlockVector = (0..6).map(|p| g[p] * phi[p]).sum();
+                let expected_load = match state {
+                    ContactState::Stick => pair.stick_load(&slip),
+                    ContactState::Open => fibercell::contact::BlockVector::zeros(),
+                    ContactState::Slip => {
+                        pair.normal().1
+                            + pair.slip(friction, &direction).1
+                            + pair.slip_perpendicular(&direction, k_perp, &anchor).1
+                    }
+                };
+                let load_scale = pair.normal().1.amax();
+                prop_assert!((load - expected_load).amax() <= 1e-12 * load_scale, "load {friction:?} {state:?}");
             }
         }
     }

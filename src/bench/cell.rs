@@ -146,8 +146,12 @@ pub struct CurveBench {
     pub state_iterations: usize,
     /// Numeric factorizations in all.
     pub factorizations: usize,
-    /// Solves by CG on an earlier factor.
+    /// Solves on an earlier factorization with a low-rank correction (see
+    /// [`crate::solve::IncrementalOptions::reuse_factor`]).
     pub factor_reuses: usize,
+    /// Residual correction steps of those solves (absent in reports written before).
+    #[serde(default)]
+    pub correction_steps: usize,
     /// Contacts sliding at the end.
     pub sliding_at_end: usize,
     /// Contacts held after chattering (summed over increments).
@@ -405,6 +409,7 @@ fn bench_curve(
         state_iterations: 0,
         factorizations: 0,
         factor_reuses: 0,
+        correction_steps: 0,
         sliding_at_end: 0,
         held: 0,
         stages: None,
@@ -425,6 +430,7 @@ fn bench_curve(
             bench.state_iterations = inc.iter().map(|r| r.iterations).sum();
             bench.factorizations = inc.iter().map(|r| r.factorizations).sum();
             bench.factor_reuses = inc.iter().map(|r| r.factor_reuses).sum();
+            bench.correction_steps = inc.iter().map(|r| r.reuse_iterations).sum();
             bench.held = inc.iter().map(|r| r.held).sum();
             let mut stages = crate::solve::IncrementTimings::default();
             inc.iter().for_each(|r| stages.add(&r.timings));

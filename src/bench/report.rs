@@ -121,12 +121,12 @@ pub fn markdown(r: &BenchReport) -> String {
         })
     });
     row(
-        "curve: state iterations / factorizations / factor reuses",
+        "curve: state iterations / factorizations / low-rank solves (correction steps)",
         &|c| {
             c.curve.as_ref().map_or("–".into(), |k| {
                 format!(
-                    "{} / {} / {}",
-                    k.state_iterations, k.factorizations, k.factor_reuses
+                    "{} / {} / {} ({})",
+                    k.state_iterations, k.factorizations, k.factor_reuses, k.correction_steps
                 )
             })
         },

@@ -5,7 +5,7 @@
 //! change of rank ≤ 6 (2 between stick and slip) in a basis fixed for the whole analysis.
 
 use super::law::{BlockVector, ContactPair, ContactState, Friction};
-use nalgebra::{SMatrix, Vector2, Vector3};
+use nalgebra::{SMatrix, Vector2, Vector3, Vector6};
 
 /// The 6 × 6 coefficients D of a contact block G D Gᵀ, in the order normal, the two tangents,
 /// the three rotation components.
@@ -81,5 +81,45 @@ impl ContactPair {
                 d
             }
         }
+    }
+
+    /// The coefficients φ of the load G φ that goes with [`ContactPair::block_coefficients`]:
+    /// stick p_N ḡ, p_T s (F_N + F_T, 4.53, 4.58, `slip` the committed slip s); open none;
+    /// slip p_N ḡ and along the direction d the friction force (Tresca −G, Coulomb μ p_N ḡ) plus
+    /// the k⊥ spring's k⊥ (p·a) p, `anchor` a its anchor.
+    pub fn load_coefficients(
+        &self,
+        s: &BlockState,
+        anchor: &Vector2<f64>,
+        slip: &Vector2<f64>,
+        friction: Friction,
+    ) -> Vector6<f64> {
+        let pn_gap = self.penalty_normal * self.gap;
+        let mut phi = Vector6::zeros();
+        match s.state {
+            ContactState::Open => {}
+            ContactState::Stick => {
+                phi[0] = pn_gap;
+                phi[1] = self.penalty_tangent * slip[0];
+                phi[2] = self.penalty_tangent * slip[1];
+            }
+            ContactState::Slip => {
+                phi[0] = pn_gap;
+                let along = match friction {
+                    Friction::None => 0.0,
+                    Friction::Coulomb { mu } => mu * pn_gap,
+                    Friction::Tresca { bound } => -bound,
+                };
+                let p = Vector2::new(-s.direction[1], s.direction[0]);
+                let across = if s.k_perp > 0.0 {
+                    s.k_perp * p.dot(anchor)
+                } else {
+                    0.0
+                };
+                phi[1] = along * s.direction[0] + across * p[0];
+                phi[2] = along * s.direction[1] + across * p[1];
+            }
+        }
+        phi
     }
 }

@@ -17,7 +17,7 @@
 //! Otherwise systems with a Coulomb-sliding contact are nonsymmetric and go to LU, all others
 //! to the chosen symmetric backend.
 
-use super::low_rank::{columns_needed, Capacitance, LowRankCorrection, SparseColumn};
+use super::low_rank::{Capacitance, ContactChange, LowRankCorrection, SparseColumn};
 use super::static_solve::{backward_tolerance, check_backward_error, locate};
 use super::{check_supported_with, make_solver, IncrementTimings, SolveOptions, SolverKind};
 use crate::assembly::{
@@ -34,7 +34,7 @@ use fibercell_solver::{
     norm_inf, solve_checked, vector_norm_inf, CscRef, LinearSolver, SolveInfo, SolveReport,
     SolverError,
 };
-use nalgebra::{DMatrix, DVector, Vector2, Vector3};
+use nalgebra::{DMatrix, DVector, Vector2, Vector3, Vector6};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -386,30 +386,24 @@ const MAX_LOW_RANK_COLUMNS: usize = 8192;
 /// costs digits that one or two steps restore).
 const MAX_REFINEMENTS: usize = 3;
 
-/// Later solves a new column of U is expected to serve: its cost (a solve with A₀ among many
-/// right-hand sides) is charged to the solve that adds it divided by this.
-const COLUMN_USES: f64 = 4.0;
-
-/// What a factorization, a solve, a new column of U and the dense LU cost in this run,
-/// measured: a low-rank solve (two solves with A₀, the new columns, the LU of order R) is done
-/// when predicted cheaper than refactorizing and solving.
+/// What a factorization, a solve and the dense LU cost in this run, measured: a low-rank solve
+/// (a solve with A₀ and the LU of order R) is done when predicted cheaper than refactorizing
+/// and solving. New columns of U are not charged: each is computed once (a solve among many
+/// right-hand sides) and serves every later solve on the same reference.
 struct LowRankCost {
     factorize: Option<f64>,
     solve: Option<f64>,
-    /// Seconds per new column, last measured (before: a quarter of a solve).
-    column: Option<f64>,
     /// Flops per second of the capacitance LU (2/3 R³ flops), last measured.
     lu_rate: f64,
 }
 
 impl LowRankCost {
-    fn worth(&self, order: usize, new: usize, columns: usize) -> bool {
+    fn worth(&self, order: usize) -> bool {
         let (Some(f), Some(s)) = (self.factorize, self.solve) else {
             return false;
         };
         let lu = 2.0 / 3.0 * (order as f64).powi(3) / self.lu_rate;
-        let extend = new as f64 * self.column.unwrap_or(0.25 * s) / COLUMN_USES;
-        columns <= MAX_LOW_RANK_COLUMNS && lu + extend + 2.0 * s <= f + s
+        lu + s <= f + s
     }
 }
 
@@ -431,11 +425,12 @@ fn norm_inf_symmetric(a: CscRef<'_>) -> f64 {
         .reduce(|| 0.0, f64::max)
 }
 
-/// Solves A x = b by the low-rank correction `cap` of the reference factorization `a0`, then
-/// corrects x with the residual of the assembled `a` until the backward error is at most
-/// `tolerance`; `None` when [`MAX_REFINEMENTS`] steps do not get there (or the capacitance
-/// matrix is singular).
-fn low_rank_solve(
+/// Corrects `first`, a solution of A x = b by the low-rank correction `cap` of the reference
+/// factorization `a0`, with the residual of the assembled `a` until the backward error is at
+/// most `tolerance`; `None` when [`MAX_REFINEMENTS`] steps do not get there (or the
+/// capacitance matrix is singular).
+#[allow(clippy::too_many_arguments)]
+fn refine_low_rank(
     low_rank: &LowRankCorrection,
     a0: &mut dyn LinearSolver,
     cap: &Capacitance,
@@ -443,8 +438,9 @@ fn low_rank_solve(
     symmetric: bool,
     b: &[f64],
     tolerance: f64,
+    first: Result<Vec<f64>, SolverError>,
 ) -> Result<Option<LowRankSolve>, SolverError> {
-    let Ok(mut x) = low_rank.solve(a0, cap, b) else {
+    let Ok(mut x) = first else {
         return Ok(None);
     };
     let norm_a = if symmetric {
@@ -491,6 +487,14 @@ fn low_rank_solve(
     Ok(None)
 }
 
+/// A contact as the reference factorization has it: block coefficients, what they and the
+/// load were computed from, and the anchor of the k⊥ spring.
+struct ReferenceBlock {
+    stiffness: BlockCoefficients,
+    state: BlockState,
+    anchor: Vector2<f64>,
+}
+
 /// Adds G ΔD Gᵀ, the change `e` of `pair`'s block coefficients, to its slots in `values`.
 fn add_block_change(pair: &ContactPair, slots: &[u32], e: &BlockCoefficients, values: &mut [f64]) {
     let g = pair.jump_basis();
@@ -534,6 +538,9 @@ type AssembledKey = (bool, Vec<ContactState>, Vec<Vector2<f64>>, Vec<f64>);
 struct Backends {
     symmetric: Option<Box<dyn LinearSolver>>,
     general: Option<Box<dyn LinearSolver>>,
+    /// The reference factorization A₀ of the low-rank solves, kept apart from `symmetric`
+    /// so that direct solves in between do not discard the correction's columns.
+    reference: Option<Box<dyn LinearSolver>>,
 }
 
 /// Runs the incremental stick/slip analysis of `model` (its supports, loads and contacts).
@@ -780,7 +787,15 @@ pub(crate) fn run_incremental(
     let mut backends = Backends {
         symmetric: None,
         general: None,
+        reference: None,
     };
+    // Low-rank solves need a direct symmetric backend.
+    let low_rank_possible = opts.reuse_factor
+        && make_solver(opts.solve.solver, &opts.solve.ordering, Vec::new())
+            .is_ok_and(|s| !s.capabilities().iterative);
+    // Set when the correction outgrew its columns or missed its accuracy: the next symmetric
+    // factorization becomes the new reference.
+    let mut refresh_reference = false;
     let node_dof = |c: usize| (c < n_free).then(|| disc.node_dof(c));
     let locate = |e: SolverError| locate(e, model, &node_dof);
 
@@ -836,12 +851,13 @@ pub(crate) fn run_incremental(
     let mut low_rank_cost = LowRankCost {
         factorize: None,
         solve: None,
-        column: None,
         lu_rate: 1e10,
     };
     // The block coefficients of every contact in the last symmetric factorization (the
     // reference A₀ of the low-rank solves), and the correction accumulated on it.
-    let mut reference: Option<Vec<BlockCoefficients>> = None;
+    let mut reference: Option<Vec<ReferenceBlock>> = None;
+    // A₀⁻¹ b₀ for this increment, b₀ the load with every contact as in the reference.
+    let mut reference_solution: Option<Vec<f64>>;
     let mut low_rank = LowRankCorrection::new(n_free, pairs.len());
     let mut reference_values = vec![0.0; pattern.nnz()];
     // Per contact, its block columns on prescribed DOFs (their products go to the load).
@@ -863,6 +879,28 @@ pub(crate) fn run_incremental(
     };
     for (step, &alpha) in (1..).zip(&path) {
         let increment_start = std::time::Instant::now();
+        // New α and committed slips: a new reference load.
+        reference_solution = None;
+        // Per contact γ = Gᵀ α ū on its prescribed DOFs: its block's products with them are
+        // the load −G D γ.
+        let prescribed_jump: Vec<Vector6<f64>> = pairs
+            .iter()
+            .zip(&prescribed)
+            .map(|(p, cols)| {
+                if cols.is_empty() {
+                    return Vector6::zeros();
+                }
+                let g = p.jump_basis();
+                Vector6::from_fn(|b, _| {
+                    cols.iter()
+                        .map(|&c| {
+                            let gdof = 6 * p.jump.nodes[c / 6] + c % 6;
+                            g[b][c] * alpha * disc.prescribed_value(gdof)
+                        })
+                        .sum()
+                })
+            })
+            .collect();
         let mut factorizations = 0;
         let mut factor_reuses = 0;
         let mut reuse_iterations_done = 0;
@@ -873,26 +911,44 @@ pub(crate) fn run_incremental(
         let lap = IncrementTimings::lap;
         let mut clock = increment_start;
         for iteration in 1..=opts.max_state_iterations {
+            let mut refactorized = false;
             // Assemble K + K_N + K_T and α F + F_N + F_T for the current states: once a
             // symmetric factorization is the reference, its values plus the blocks of the
             // contacts that changed since (G ΔD Gᵀ), else element and contact blocks anew.
-            let changes: Option<Vec<(usize, BlockCoefficients)>> =
-                reference.as_ref().map(|reference| {
-                    (0..pairs.len())
-                        .filter_map(|i| {
-                            let e = pairs[i].block_coefficients(
-                                &block_state(&states, &directions, &perpendicular, i),
-                                friction,
-                                stabilization,
-                            ) - reference[i];
-                            (columns_needed(&e) > 0).then_some((i, e))
-                        })
-                        .collect()
-                });
+            let changes: Option<Vec<ContactChange>> = reference.as_ref().map(|reference| {
+                (0..pairs.len())
+                    .filter_map(|i| {
+                        let current = block_state(&states, &directions, &perpendicular, i);
+                        let r = &reference[i];
+                        let stiffness =
+                            pairs[i].block_coefficients(&current, friction, stabilization)
+                                - r.stiffness;
+                        let load = pairs[i].load_coefficients(
+                            &current,
+                            &perpendicular[i].1,
+                            &slips[i],
+                            friction,
+                        ) - pairs[i]
+                            .load_coefficients(&r.state, &r.anchor, &slips[i], friction)
+                            - stiffness * prescribed_jump[i];
+                        let change = ContactChange {
+                            contact: i,
+                            stiffness,
+                            load,
+                        };
+                        change.is_change().then_some(change)
+                    })
+                    .collect()
+            });
             if let Some(changes) = &changes {
                 values.copy_from_slice(&reference_values);
-                for (i, e) in changes {
-                    add_block_change(&pairs[*i], pattern.extra_slots(*i), e, &mut values);
+                for ch in changes {
+                    add_block_change(
+                        &pairs[ch.contact],
+                        pattern.extra_slots(ch.contact),
+                        &ch.stiffness,
+                        &mut values,
+                    );
                 }
             } else {
                 values.copy_from_slice(&k_elastic);
@@ -990,20 +1046,18 @@ pub(crate) fn run_incremental(
             let mut reused = None;
             if let (Some(changes), Some(a0), true) = (
                 changes.as_ref(),
-                backends.symmetric.as_mut(),
-                opts.reuse_factor && n_free > 0,
+                backends.reference.as_mut(),
+                n_free > 0 && !refresh_reference,
             ) {
                 let (order, new) = low_rank.size_of(changes);
-                if low_rank_cost.worth(order, new, low_rank.len() + new) {
-                    let started = std::time::Instant::now();
+                if low_rank.len() + new > MAX_LOW_RANK_COLUMNS {
+                    refresh_reference = true;
+                } else if low_rank_cost.worth(order) {
                     low_rank
                         .extend(a0.as_mut(), changes, |c, k| {
                             low_rank_column(&pairs[c], disc, k)
                         })
                         .map_err(locate)?;
-                    if new > 0 {
-                        low_rank_cost.column = Some(started.elapsed().as_secs_f64() / new as f64);
-                    }
                     let started = std::time::Instant::now();
                     let cap = low_rank.capacitance(changes);
                     if order > 0 {
@@ -1012,9 +1066,29 @@ pub(crate) fn run_incremental(
                         .max(1e8);
                     }
                     let tol = REUSE_ACCURACY * backward_tolerance(&opts.solve);
-                    reused =
-                        low_rank_solve(&low_rank, a0.as_mut(), &cap, a, !nonsymmetric, &rhs, tol)
-                            .map_err(locate)?;
+                    let load = low_rank.active_load(changes);
+                    if reference_solution.is_none() {
+                        let shift = low_rank.spread(&cap, &load);
+                        let mut x0: Vec<f64> = rhs.iter().zip(&shift).map(|(b, s)| b - s).collect();
+                        a0.solve_in_place(&mut x0, 1).map_err(locate)?;
+                        reference_solution = Some(x0);
+                    }
+                    let first = match &reference_solution {
+                        Some(x0) => low_rank.solve_from(a0.as_mut(), &cap, x0, &load),
+                        None => low_rank.solve(a0.as_mut(), &cap, &rhs),
+                    };
+                    reused = refine_low_rank(
+                        &low_rank,
+                        a0.as_mut(),
+                        &cap,
+                        a,
+                        !nonsymmetric,
+                        &rhs,
+                        tol,
+                        first,
+                    )
+                    .map_err(locate)?;
+                    refresh_reference = reused.is_none();
                     lap(&mut timings.factor_reuse, &mut clock);
                 }
             }
@@ -1032,8 +1106,16 @@ pub(crate) fn run_incremental(
                 };
                 (r.x, Some(report))
             } else {
+                // The first symmetric factorization, or the next after the correction outgrew its
+                // columns or its accuracy, becomes the reference (in its own solver).
+                let make_reference = !nonsymmetric
+                    && low_rank_possible
+                    && n_free > 0
+                    && (reference.is_none() || refresh_reference);
                 let (slot, kind) = if nonsymmetric {
                     (&mut backends.general, SolverKind::FaerLu)
+                } else if make_reference {
+                    (&mut backends.reference, opts.solve.solver)
                 } else {
                     (&mut backends.symmetric, opts.solve.solver)
                 };
@@ -1052,24 +1134,35 @@ pub(crate) fn run_incremental(
                     perpendicular.iter().map(|p| p.0).collect::<Vec<f64>>(),
                 );
                 lap(&mut timings.factorize, &mut clock);
-                if factorized.as_ref() != Some(&key) {
+                if make_reference || factorized.as_ref() != Some(&key) {
                     let started = std::time::Instant::now();
                     solver.factorize(a).map_err(locate)?;
                     factorizations += 1;
-                    factorized = Some(key);
-                    if !nonsymmetric && !solver.capabilities().iterative {
+                    if !nonsymmetric {
                         low_rank_cost.factorize = Some(started.elapsed().as_secs_f64());
+                    }
+                    if !make_reference {
+                        factorized = Some(key);
+                    } else {
+                        refresh_reference = false;
                         reference = Some(
                             (0..pairs.len())
                                 .map(|i| {
-                                    pairs[i].block_coefficients(
-                                        &block_state(&states, &directions, &perpendicular, i),
-                                        friction,
-                                        stabilization,
-                                    )
+                                    let state =
+                                        block_state(&states, &directions, &perpendicular, i);
+                                    ReferenceBlock {
+                                        stiffness: pairs[i].block_coefficients(
+                                            &state,
+                                            friction,
+                                            stabilization,
+                                        ),
+                                        state,
+                                        anchor: perpendicular[i].1,
+                                    }
                                 })
                                 .collect(),
                         );
+                        refactorized = true;
                         reference_values.copy_from_slice(&values);
                         low_rank.reset();
                     }
@@ -1082,6 +1175,10 @@ pub(crate) fn run_incremental(
                     let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1).map_err(locate)?;
                     if !nonsymmetric {
                         low_rank_cost.solve = Some(started.elapsed().as_secs_f64());
+                    }
+                    if refactorized {
+                        // The reference's own load: A₀⁻¹ b₀ of this increment.
+                        reference_solution = Some(x.clone());
                     }
                     (x, Some(r))
                 }

@@ -16,6 +16,7 @@ use crate::contact::BlockCoefficients;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut, MatRef};
 use fibercell_solver::{LinearSolver, SolverError};
+use nalgebra::Vector6;
 use rayon::prelude::*;
 
 /// The order in which a contact's jump rows become columns of U: the two tangents first (all a
@@ -26,9 +27,31 @@ const ORDER: [usize; 6] = [1, 2, 0, 3, 4, 5];
 /// Bytes of right-hand sides solved for at once when columns are added.
 const BATCH_BYTES: usize = 256 << 20;
 
-/// How many leading entries of the column order a coefficient change `e` needs (0: none).
-pub(crate) fn columns_needed(e: &BlockCoefficients) -> usize {
-    let touches = |i: usize| (0..6).any(|j| e[(i, j)] != 0.0 || e[(j, i)] != 0.0);
+/// One contact's change since the reference: of its block coefficients (ΔD) and of its load
+/// coefficients (Δχ, the load G χ including the products of the block with prescribed DOFs).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ContactChange {
+    pub contact: usize,
+    pub stiffness: BlockCoefficients,
+    pub load: Vector6<f64>,
+}
+
+impl ContactChange {
+    /// Whether anything changed.
+    pub(crate) fn is_change(&self) -> bool {
+        self.columns_needed() > 0
+    }
+
+    /// How many leading entries of the column order the change needs (0: none).
+    fn columns_needed(&self) -> usize {
+        columns_needed(&self.stiffness, &self.load)
+    }
+}
+
+/// How many leading entries of the column order a change `e` of block coefficients and `f` of
+/// load coefficients need (0: none).
+fn columns_needed(e: &BlockCoefficients, f: &Vector6<f64>) -> usize {
+    let touches = |i: usize| f[i] != 0.0 || (0..6).any(|j| e[(i, j)] != 0.0 || e[(j, i)] != 0.0);
     if (3..6).any(touches) {
         6
     } else if touches(0) {
@@ -84,6 +107,11 @@ impl LowRankCorrection {
         }
     }
 
+    /// Right-hand sides solved for at once.
+    fn batch(&self) -> usize {
+        (BATCH_BYTES / (8 * self.n.max(1))).clamp(2, 256)
+    }
+
     /// Forgets all columns (A₀ was refactorized).
     pub(crate) fn reset(&mut self) {
         self.columns.clear();
@@ -97,10 +125,10 @@ impl LowRankCorrection {
     }
 
     /// The order of the capacitance matrix of `changes` and how many of its columns are new.
-    pub(crate) fn size_of(&self, changes: &[(usize, BlockCoefficients)]) -> (usize, usize) {
-        changes.iter().fold((0, 0), |(order, new), (c, e)| {
-            let have = self.owned[*c].len();
-            let need = columns_needed(e).max(have);
+    pub(crate) fn size_of(&self, changes: &[ContactChange]) -> (usize, usize) {
+        changes.iter().fold((0, 0), |(order, new), ch| {
+            let have = self.owned[ch.contact].len();
+            let need = ch.columns_needed().max(have);
             (order + need, new + need - have)
         })
     }
@@ -110,17 +138,18 @@ impl LowRankCorrection {
     pub(crate) fn extend(
         &mut self,
         a0: &mut dyn LinearSolver,
-        changes: &[(usize, BlockCoefficients)],
+        changes: &[ContactChange],
         column: impl Fn(usize, usize) -> SparseColumn + Sync,
     ) -> Result<(), SolverError> {
         let first = self.columns.len();
         let wanted: Vec<(usize, usize)> = changes
             .iter()
-            .flat_map(|(c, e)| {
-                let have = self.owned[*c].len();
-                (have..columns_needed(e).max(have)).map(move |k| (*c, ORDER[k]))
+            .flat_map(|ch| {
+                let (c, have) = (ch.contact, self.owned[ch.contact].len());
+                (have..ch.columns_needed().max(have)).map(move |k| (c, ORDER[k]))
             })
             .collect();
+        let batch = self.batch();
         if wanted.is_empty() {
             return Ok(());
         }
@@ -132,7 +161,6 @@ impl LowRankCorrection {
         let total = self.columns.len();
         let n = self.n;
         self.s.resize_with(total, total, |_, _| 0.0);
-        let batch = (BATCH_BYTES / (8 * n.max(1))).clamp(1, 256);
         for start in (first..total).step_by(batch) {
             let end = (start + batch).min(total);
             let k = end - start;
@@ -164,11 +192,12 @@ impl LowRankCorrection {
 
     /// Factorizes I + E S for `changes` (each contact's columns must be there: see
     /// [`LowRankCorrection::extend`]).
-    pub(crate) fn capacitance(&self, changes: &[(usize, BlockCoefficients)]) -> Capacitance {
+    pub(crate) fn capacitance(&self, changes: &[ContactChange]) -> Capacitance {
         let blocks: Vec<(Vec<usize>, Vec<f64>)> = changes
             .iter()
-            .map(|(c, e)| {
-                let cols = self.owned[*c].clone();
+            .map(|ch| {
+                let e = &ch.stiffness;
+                let cols = self.owned[ch.contact].clone();
                 let k = cols.len();
                 let mut block = vec![0.0; k * k];
                 for i in 0..k {
@@ -201,7 +230,27 @@ impl LowRankCorrection {
         Capacitance { blocks, active, lu }
     }
 
-    /// x = (A₀ + U E Uᵀ)⁻¹ b for the changes factorized in `cap`, `a0` the factorization of A₀.
+    /// The load changes Δχ of `changes` on the columns of `cap` (same order).
+    pub(crate) fn active_load(&self, changes: &[ContactChange]) -> Vec<f64> {
+        changes
+            .iter()
+            .flat_map(|ch| (0..self.owned[ch.contact].len()).map(|k| ch.load[ORDER[k]]))
+            .collect()
+    }
+
+    /// U v for `v` on the columns of `cap`.
+    pub(crate) fn spread(&self, cap: &Capacitance, v: &[f64]) -> Vec<f64> {
+        let mut w = vec![0.0; self.n];
+        for (&col, vj) in cap.active.iter().zip(v) {
+            for &(i, u) in &self.columns[col] {
+                w[i] += u * vj;
+            }
+        }
+        w
+    }
+
+    /// x = (A₀ + U E Uᵀ)⁻¹ b for the changes factorized in `cap`, `a0` the factorization of A₀:
+    /// two solves with A₀.
     pub(crate) fn solve(
         &self,
         a0: &mut dyn LinearSolver,
@@ -210,11 +259,56 @@ impl LowRankCorrection {
     ) -> Result<Vec<f64>, SolverError> {
         let mut x = b.to_vec();
         a0.solve_in_place(&mut x, 1)?;
+        let y: Vec<f64> = cap
+            .active
+            .iter()
+            .map(|&c| dot(&self.columns[c], &x))
+            .collect();
+        self.correct(a0, cap, x, y, None)
+    }
+
+    /// The same for b = b₀ + U Δχ, from x₀ = A₀⁻¹ b₀ and the load change `load` on the columns
+    /// of `cap` ([`LowRankCorrection::active_load`]): one solve with A₀, as
+    /// A₀⁻¹ b = x₀ + A₀⁻¹ U Δχ and Uᵀ A₀⁻¹ b = Uᵀ x₀ + S Δχ.
+    pub(crate) fn solve_from(
+        &self,
+        a0: &mut dyn LinearSolver,
+        cap: &Capacitance,
+        x0: &[f64],
+        load: &[f64],
+    ) -> Result<Vec<f64>, SolverError> {
+        let y: Vec<f64> = cap
+            .active
+            .iter()
+            .map(|&c| {
+                dot(&self.columns[c], x0)
+                    + cap
+                        .active
+                        .iter()
+                        .zip(load)
+                        .map(|(&l, v)| self.s[(c, l)] * v)
+                        .sum::<f64>()
+            })
+            .collect();
+        self.correct(a0, cap, x0.to_vec(), y, Some(load))
+    }
+
+    /// x + A₀⁻¹ U (Δχ − z) with (I + E S) z = E y (Δχ = 0 when `load` is `None`).
+    fn correct(
+        &self,
+        a0: &mut dyn LinearSolver,
+        cap: &Capacitance,
+        mut x: Vec<f64>,
+        y: Vec<f64>,
+        load: Option<&[f64]>,
+    ) -> Result<Vec<f64>, SolverError> {
         let mut z = Vec::with_capacity(cap.order());
+        let mut offset = 0;
         for (cols, e) in &cap.blocks {
             let k = cols.len();
-            let u: Vec<f64> = cols.iter().map(|&c| dot(&self.columns[c], &x)).collect();
+            let u = &y[offset..offset + k];
             z.extend((0..k).map(|i| (0..k).map(|l| e[i * k + l] * u[l]).sum::<f64>()));
+            offset += k;
         }
         let r = z.len();
         cap.lu
@@ -225,14 +319,13 @@ impl LowRankCorrection {
                 index: i,
             });
         }
-        let mut w = vec![0.0; self.n];
-        for (&col, zj) in cap.active.iter().zip(&z) {
-            for &(i, v) in &self.columns[col] {
-                w[i] += v * zj;
-            }
-        }
+        let v: Vec<f64> = match load {
+            Some(load) => load.iter().zip(&z).map(|(l, zj)| l - zj).collect(),
+            None => z.iter().map(|zj| -zj).collect(),
+        };
+        let mut w = self.spread(cap, &v);
         a0.solve_in_place(&mut w, 1)?;
-        x.iter_mut().zip(&w).for_each(|(xi, wi)| *xi -= wi);
+        x.iter_mut().zip(&w).for_each(|(xi, wi)| *xi += wi);
         Ok(x)
     }
 }
@@ -290,12 +383,23 @@ mod tests {
             }
             e
         };
+        let ch = |c: usize, level: usize| ContactChange {
+            contact: c,
+            stiffness: change(c, level),
+            load: Vector6::from_fn(|i, _| {
+                if ORDER[..level].contains(&i) {
+                    0.5 - 0.1 * (i + c) as f64
+                } else {
+                    0.0
+                }
+            }),
+        };
         let mut low_rank = LowRankCorrection::new(n, 4);
-        let first = vec![(0, change(0, 2)), (2, change(2, 3))];
+        let first = vec![ch(0, 2), ch(2, 3)];
         low_rank
             .extend(solver.as_mut(), &first, column)
             .expect("extend");
-        let changes = vec![(0, change(0, 2)), (1, change(1, 6)), (2, change(2, 3))];
+        let changes = vec![ch(0, 2), ch(1, 6), ch(2, 3)];
         assert_eq!(low_rank.size_of(&changes), (11, 6));
         low_rank
             .extend(solver.as_mut(), &changes, column)
@@ -313,7 +417,8 @@ mod tests {
             }
             v
         };
-        for (c, e) in &changes {
+        for change in &changes {
+            let (c, e) = (&change.contact, &change.stiffness);
             for p in 0..6 {
                 for q in 0..6 {
                     if e[(p, q)] != 0.0 {
