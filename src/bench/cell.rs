@@ -12,7 +12,10 @@ use crate::homogenize::{
     elasto_plastic_curve, homogenize_elastic, ContactStiffness, CurveOptions, PeriodicSystem,
 };
 use crate::model::{FrictionSpec, Model};
-use crate::solve::{make_solver, IncrementalOptions, SolveOptions, SolverKind};
+use crate::solve::{
+    make_solver, ContactChange, IncrementalOptions, LowRankCorrection, SolveOptions, SolverKind,
+    SparseColumn,
+};
 use crate::Error;
 use fibercell_solver::{backward_error, pcg_with_factor, CscRef, Ordering};
 use serde::{Deserialize, Serialize};
@@ -102,6 +105,22 @@ pub struct ReuseBench {
     /// That relative to CHOLMOD's numeric factorization plus solve.
     #[serde(default)]
     pub updown_next_ratio: Option<f64>,
+    /// The low-rank (Woodbury) solve on faer's factor of the unswitched matrix, as the
+    /// incremental solver does it: the 2k columns of S = Uᵀ A₀⁻¹ U (solves with 2k right-hand
+    /// sides), the LU of I + E S and two solves (s). Absent in reports written before.
+    #[serde(default)]
+    pub low_rank_seconds: Option<f64>,
+    /// The next low-rank solve on the same columns as in a stick/slip iteration, whose load
+    /// changed within them: the LU and one solve, from A₀⁻¹ b₀ known (s).
+    #[serde(default)]
+    pub low_rank_next_seconds: Option<f64>,
+    /// Normwise backward error of the first low-rank solve on the switched matrix.
+    #[serde(default)]
+    pub low_rank_backward_error: Option<f64>,
+    /// The first and the next low-rank solve relative to faer's numeric factorization plus
+    /// solve.
+    #[serde(default)]
+    pub low_rank_ratios: Option<[f64; 2]>,
 }
 
 /// A factorized solver and the seconds of its numeric factorization plus one solve.
@@ -291,6 +310,53 @@ fn bench_backend(
     })
 }
 
+/// The contacts `list` switched stick → sliding as the low-rank correction A₀ − W Wᵀ (W their
+/// stick-spring columns, E = −I) of the factorization `a0` of the unswitched matrix: seconds of
+/// the first solve (columns, LU, two solves), of the next on the same columns with the load
+/// changed within them (LU, one solve), and the first's backward error on the switched matrix
+/// `a`.
+fn low_rank_switch(
+    sys: &PeriodicSystem,
+    a0: &mut dyn fibercell_solver::LinearSolver,
+    a: CscRef<'_>,
+    rhs: &[f64],
+    list: &[usize],
+) -> Result<(f64, f64, f64), Error> {
+    let w = sys.stick_spring_matrix(list)?;
+    let w = w.as_ref();
+    // Contact j owns the columns 2j, 2j + 1 of W, as basis rows 1 and 2 (the tangents).
+    let column = |j: usize, k: usize| -> SparseColumn {
+        let (rows, vals) = w.col(2 * j + k - 1);
+        rows.iter().copied().zip(vals.iter().copied()).collect()
+    };
+    let mut stiffness = crate::contact::BlockCoefficients::zeros();
+    stiffness[(1, 1)] = -1.0;
+    stiffness[(2, 2)] = -1.0;
+    let changes: Vec<ContactChange> = (0..list.len())
+        .map(|contact| ContactChange {
+            contact,
+            stiffness,
+            load: nalgebra::Vector6::zeros(),
+        })
+        .collect();
+    let mut low_rank = LowRankCorrection::new(a.ncols(), list.len());
+    let t = Instant::now();
+    low_rank.extend(a0, &changes, column)?;
+    let cap = low_rank.capacitance(&changes);
+    let x = low_rank.solve(a0, &cap, rhs)?;
+    let first = t.elapsed().as_secs_f64();
+    let error = backward_error(a, &x, rhs);
+    // The next solve as in a stick/slip iteration: the load changed within the switched
+    // contacts' columns, solved from A₀⁻¹ b₀ of the increment (known) with one solve.
+    let mut x0 = rhs.to_vec();
+    a0.solve_in_place(&mut x0, 1)?;
+    let load = vec![1.0; cap.order()];
+    let t = Instant::now();
+    let cap = low_rank.capacitance(&changes);
+    low_rank.solve_from(a0, &cap, &x0, &load)?;
+    Ok((first, t.elapsed().as_secs_f64(), error))
+}
+
 /// Solves after switching k contacts, for k at the given fractions of the contacts; CG stops
 /// once it has spent about two refactorizations.
 fn bench_reuse(
@@ -333,10 +399,11 @@ fn bench_reuse(
         let t = Instant::now();
         let r = pcg_with_factor(factor.as_mut(), a, rhs, 1e-13, max_iterations)?;
         let seconds = t.elapsed().as_secs_f64();
+        let list: Vec<usize> = (0..n_contacts).filter(|&i| switched(i)).collect();
+        let low_rank = low_rank_switch(sys, factor.as_mut(), a, rhs, &list)?;
         let mut measured = None;
         let cholmod_refactor = updown.as_ref().map_or(f64::NAN, |u| u.1);
         if let Some((solver, _)) = updown.as_mut() {
-            let list: Vec<usize> = (0..n_contacts).filter(|&i| switched(i)).collect();
             let w = sys.stick_spring_matrix(&list)?;
             solver.factorize(a0)?;
             let t = Instant::now();
@@ -365,6 +432,10 @@ fn bench_reuse(
             updown_backward_error: measured.map(|m| m.1),
             updown_next_seconds: measured.map(|m| m.2),
             updown_next_ratio: measured.map(|m| m.2 / cholmod_refactor),
+            low_rank_seconds: Some(low_rank.0),
+            low_rank_next_seconds: Some(low_rank.1),
+            low_rank_backward_error: Some(low_rank.2),
+            low_rank_ratios: Some([low_rank.0 / refactor, low_rank.1 / refactor]),
         });
     }
     Ok(out)

@@ -180,15 +180,19 @@ pub fn markdown(r: &BenchReport) -> String {
     let _ = writeln!(
         s,
         "| cell | contacts switched | fraction | CG on the old factor: iterations | seconds | \
-         of a refactorization | CHOLMOD downdate + solve, first | next | of CHOLMOD's \
+         of a refactorization | low-rank on faer's factor, first / next | of a refactorization \
+         (first / next) | backward error | CHOLMOD downdate + solve, first | next | of CHOLMOD's \
          refactorization (first / next) | backward error |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
     for c in &r.cells {
         for u in &c.reuse {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.1} % | {}{} | {} | {:.2} | {} | {} | {} | {} |",
+                "| {} | {} | {:.1} % | {}{} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
                 c.cell,
                 u.switched,
                 100.0 * u.fraction,
@@ -196,6 +200,12 @@ pub fn markdown(r: &BenchReport) -> String {
                 if u.converged { "" } else { " (not converged)" },
                 ms(u.seconds),
                 u.ratio_to_refactorization,
+                match (u.low_rank_seconds, u.low_rank_next_seconds) {
+                    (Some(a), Some(b)) => format!("{} / {}", ms(a), ms(b)),
+                    _ => "–".into(),
+                },
+                opt(u.low_rank_ratios.map(|[a, b]| format!("{a:.2} / {b:.2}"))),
+                opt(u.low_rank_backward_error.map(|x| format!("{x:.1e}"))),
                 opt(u.updown_seconds.map(ms)),
                 opt(u.updown_next_seconds.map(ms)),
                 match (u.updown_ratio, u.updown_next_ratio) {

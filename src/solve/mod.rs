@@ -16,6 +16,7 @@ pub use incremental::{
     solve_incremental, ContactRecord, IncrementRecord, IncrementalOptions, IncrementalSolution,
     Progress,
 };
+pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
 pub use reduced::ReducedSystem;
 pub(crate) use static_solve::{check_backward_error, locate};
 pub use static_solve::{solve_static, SolveOptions, SolveSummary, StaticSolution, Timings};
