@@ -1,7 +1,7 @@
 //! The stages of one benchmark cell: generation, contact search, pattern, value fill, every
 //! applicable backend's symbolic analysis, numeric factorization and solve, the solve after a
-//! few contact switches with the previous factor as preconditioner, the six elastic cell
-//! problems and an elasto-plastic curve.
+//! few contact switches on the previous factor (CG, the low-rank correction, CHOLMOD's
+//! downdate), the six elastic cell problems and an elasto-plastic curve.
 
 use super::machine::peak_memory_bytes;
 use super::BenchOptions;
@@ -69,8 +69,9 @@ pub struct BackendBench {
     pub solve_fraction_of_bandwidth: Option<f64>,
 }
 
-/// The solve after k contacts switched stick → sliding, by CG preconditioned with the factor of
-/// the unswitched matrix, against a refactorization.
+/// The solve after k contacts switched stick → sliding on the factor of the unswitched matrix
+/// (CG preconditioned with it, its low-rank correction, CHOLMOD's downdate), against a
+/// refactorization.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ReuseBench {
     /// Contacts switched.

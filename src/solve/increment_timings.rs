@@ -9,7 +9,8 @@ pub struct IncrementTimings {
     pub assemble: f64,
     /// Numeric factorizations (and the one symbolic analysis of the run, in the first increment).
     pub factorize: f64,
-    /// Solves by CG preconditioned with an earlier factorization, failed attempts included.
+    /// Solves on an earlier factorization with a low-rank correction (new columns of S, the
+    /// capacitance LU, the solves), failed attempts included.
     pub factor_reuse: f64,
     /// Direct solves with the current factorization, with their backward-error check.
     pub solve: f64,
