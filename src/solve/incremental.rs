@@ -31,8 +31,8 @@ use crate::contact::{
 use crate::model::Model;
 use crate::Error;
 use fibercell_solver::{
-    norm_inf, solve_checked, vector_norm_inf, CscRef, LinearSolver, SolveInfo, SolveReport,
-    SolverError,
+    backward_from_product, norm_inf, norm_inf_symmetric_par, relative_from_product, solve_checked,
+    CscRef, LinearSolver, SolveInfo, SolveReport, SolverError,
 };
 use nalgebra::{DMatrix, DVector, Vector2, Vector3, Vector6};
 use rayon::prelude::*;
@@ -81,8 +81,8 @@ pub struct IncrementalOptions {
     /// After the first factorization, solve on it: the contacts whose block changed since (a
     /// state, a slip direction or the tangent across it) are a low-rank correction U E Uᵀ in
     /// their jump rows, solved by the Sherman–Morrison–Woodbury formula with S = Uᵀ A₀⁻¹ U
-    /// kept across iterations and increments (see `low_rank.rs`), while its dense LU and two
-    /// solves are predicted cheaper than refactorizing (measured times); the result is
+    /// kept across iterations and increments (see `low_rank.rs`), while its dense capacitance
+    /// factorization is predicted cheaper than refactorizing (measured times); the result is
     /// corrected with the residual of the assembled matrix until its backward error is 10⁵
     /// times below the accepted one, as accurate as a direct solve, else the matrix is
     /// refactorized and becomes the new reference (default true). Needs a direct symmetric
@@ -386,24 +386,21 @@ const MAX_LOW_RANK_COLUMNS: usize = 8192;
 /// costs digits that one or two steps restore).
 const MAX_REFINEMENTS: usize = 3;
 
-/// What a factorization, a solve and the dense LU cost in this run, measured: a low-rank solve
-/// (a solve with A₀ and the LU of order R) is done when predicted cheaper than refactorizing
-/// and solving. New columns of U are not charged: each is computed once (a solve among many
-/// right-hand sides) and serves every later solve on the same reference.
+/// What a factorization and the capacitance factorization cost in this run, measured: a
+/// low-rank solve (the capacitance factorization and one solve with A₀, against a
+/// factorization and one solve) is done while its capacitance factorization is predicted
+/// cheaper than a factorization. New columns of U are not charged: each is computed once (a
+/// solve among many right-hand sides) and serves every later solve on the same reference.
 struct LowRankCost {
     factorize: Option<f64>,
-    solve: Option<f64>,
-    /// Flops per second of the capacitance LU (2/3 R³ flops), last measured.
+    /// Flops per second of the capacitance factorization (2/3 R³ flops as an LU), last measured.
     lu_rate: f64,
 }
 
 impl LowRankCost {
     fn worth(&self, order: usize) -> bool {
-        let (Some(f), Some(s)) = (self.factorize, self.solve) else {
-            return false;
-        };
         let lu = 2.0 / 3.0 * (order as f64).powi(3) / self.lu_rate;
-        lu + s <= f + s
+        self.factorize.is_some_and(|f| lu <= f)
     }
 }
 
@@ -414,15 +411,6 @@ struct LowRankSolve {
     backward_error: f64,
     relative_residual: f64,
     refinements: usize,
-}
-
-/// ‖A‖∞ of a symmetric A stored in full: its largest column sum, column by column in parallel.
-fn norm_inf_symmetric(a: CscRef<'_>) -> f64 {
-    (0..a.ncols())
-        .into_par_iter()
-        .with_min_len(1024)
-        .map(|j| a.col(j).1.iter().map(|v| v.abs()).sum::<f64>())
-        .reduce(|| 0.0, f64::max)
 }
 
 /// Corrects `first`, a solution of A x = b by the low-rank correction `cap` of the reference
@@ -444,11 +432,10 @@ fn refine_low_rank(
         return Ok(None);
     };
     let norm_a = if symmetric {
-        norm_inf_symmetric(a)
+        norm_inf_symmetric_par(a)
     } else {
         norm_inf(a)
     };
-    let norm_b = vector_norm_inf(b);
     let mut ax = vec![0.0; b.len()];
     for refinements in 0..=MAX_REFINEMENTS {
         if symmetric {
@@ -456,21 +443,13 @@ fn refine_low_rank(
         } else {
             a.mul_vec(&x, &mut ax);
         }
-        let r: Vec<f64> = b.iter().zip(&ax).map(|(p, q)| p - q).collect();
-        let denom = norm_a * vector_norm_inf(&x) + norm_b;
-        let backward_error = if denom > 0.0 {
-            vector_norm_inf(&r) / denom
-        } else {
-            vector_norm_inf(&r)
-        };
+        let backward_error = backward_from_product(norm_a, &ax, &x, b);
         if !backward_error.is_finite() {
             return Ok(None);
         }
         if backward_error <= tolerance {
-            let two = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let nb = two(b);
             return Ok(Some(LowRankSolve {
-                relative_residual: if nb > 0.0 { two(&r) / nb } else { two(&r) },
+                relative_residual: relative_from_product(&ax, b),
                 x,
                 backward_error,
                 refinements,
@@ -479,6 +458,7 @@ fn refine_low_rank(
         if refinements == MAX_REFINEMENTS {
             break;
         }
+        let r: Vec<f64> = b.iter().zip(&ax).map(|(p, q)| p - q).collect();
         let Ok(dx) = low_rank.solve(a0, cap, &r) else {
             return Ok(None);
         };
@@ -850,7 +830,6 @@ pub(crate) fn run_incremental(
     // CG iterations preconditioned by the previous factorization allowed per solve (0: none).
     let mut low_rank_cost = LowRankCost {
         factorize: None,
-        solve: None,
         lu_rate: 1e10,
     };
     // The block coefficients of every contact in the last symmetric factorization (the
@@ -1067,16 +1046,19 @@ pub(crate) fn run_incremental(
                     }
                     let tol = REUSE_ACCURACY * backward_tolerance(&opts.solve);
                     let load = low_rank.active_load(changes);
-                    if reference_solution.is_none() {
-                        let shift = low_rank.spread(&cap, &load);
-                        let mut x0: Vec<f64> = rhs.iter().zip(&shift).map(|(b, s)| b - s).collect();
-                        a0.solve_in_place(&mut x0, 1).map_err(locate)?;
-                        reference_solution = Some(x0);
-                    }
-                    let first = match &reference_solution {
-                        Some(x0) => low_rank.solve_from(a0.as_mut(), &cap, x0, &load),
-                        None => low_rank.solve(a0.as_mut(), &cap, &rhs),
+                    let x0 = match reference_solution.take() {
+                        Some(x0) => x0,
+                        None => {
+                            // b₀ = b − U Δχ, the load with every contact as in the reference.
+                            let shift = low_rank.spread(&cap, &load);
+                            let mut x0: Vec<f64> =
+                                rhs.iter().zip(&shift).map(|(b, s)| b - s).collect();
+                            a0.solve_in_place(&mut x0, 1).map_err(locate)?;
+                            x0
+                        }
                     };
+                    let first = low_rank.solve_from(a0.as_mut(), &cap, &x0, &load);
+                    reference_solution = Some(x0);
                     reused = refine_low_rank(
                         &low_rank,
                         a0.as_mut(),
@@ -1171,11 +1153,7 @@ pub(crate) fn run_incremental(
                 if n_free == 0 {
                     (Vec::new(), None)
                 } else {
-                    let started = std::time::Instant::now();
                     let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1).map_err(locate)?;
-                    if !nonsymmetric {
-                        low_rank_cost.solve = Some(started.elapsed().as_secs_f64());
-                    }
                     if refactorized {
                         // The reference's own load: A₀⁻¹ b₀ of this increment.
                         reference_solution = Some(x.clone());

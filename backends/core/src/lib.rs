@@ -30,6 +30,7 @@ pub use factor_pcg::{pcg_with_factor, FactorPcg};
 pub use lower::LowerTriangle;
 pub use ordering::{compute_ordering, Ordering, Permutation};
 pub use residual::{
-    backward_error, norm_inf, relative_residual, solve_checked, vector_norm_inf, SolveReport,
+    backward_error, backward_from_product, norm_inf, norm_inf_symmetric_par, relative_from_product,
+    relative_residual, solve_checked, vector_norm_inf, SolveReport,
 };
 pub use solver::{AnalyzeInfo, Capabilities, LinearSolver, SolveInfo};

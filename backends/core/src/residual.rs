@@ -24,7 +24,7 @@ pub fn relative_residual(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
 }
 
 /// ‖Ax − b‖₂ / ‖b‖₂ from the product `ax` = Ax.
-fn relative_from_product(ax: &[f64], b: &[f64]) -> f64 {
+pub fn relative_from_product(ax: &[f64], b: &[f64]) -> f64 {
     let r: f64 = ax
         .iter()
         .zip(b)
@@ -48,6 +48,17 @@ pub fn norm_inf(a: CscRef<'_>) -> f64 {
     row_sums.iter().fold(0.0f64, |m, v| m.max(*v))
 }
 
+/// ‖A‖∞ of a **symmetric** A stored in full: its largest absolute column sum, columns in
+/// parallel (each sum by one task: the result does not depend on threads).
+pub fn norm_inf_symmetric_par(a: CscRef<'_>) -> f64 {
+    use rayon::prelude::*;
+    (0..a.ncols())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|j| a.col(j).1.iter().map(|v| v.abs()).sum::<f64>())
+        .reduce(|| 0.0, f64::max)
+}
+
 /// ‖v‖∞ (0 for an empty vector).
 pub fn vector_norm_inf(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
@@ -60,8 +71,8 @@ pub fn backward_error(a: CscRef<'_>, x: &[f64], b: &[f64]) -> f64 {
     backward_from_product(norm_inf(a), &ax, x, b)
 }
 
-/// The backward error from the product `ax` = Ax and ‖A‖∞.
-fn backward_from_product(norm_a: f64, ax: &[f64], x: &[f64], b: &[f64]) -> f64 {
+/// The backward error ‖Ax − b‖∞ / (‖A‖∞‖x‖∞ + ‖b‖∞) from the product `ax` = Ax and ‖A‖∞.
+pub fn backward_from_product(norm_a: f64, ax: &[f64], x: &[f64], b: &[f64]) -> f64 {
     let r = ax
         .iter()
         .zip(b)
