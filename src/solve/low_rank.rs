@@ -15,7 +15,8 @@
 use crate::contact::BlockCoefficients;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut, MatRef};
-use fibercell_solver::{LinearSolver, SolverError};
+use fibercell_solver::{ForwardColumns, LinearSolver, SolverError};
+use std::collections::HashMap;
 use nalgebra::Vector6;
 use rayon::prelude::*;
 
@@ -26,6 +27,12 @@ const ORDER: [usize; 6] = [1, 2, 0, 3, 4, 5];
 
 /// Bytes of right-hand sides solved for at once when columns are added.
 const BATCH_BYTES: usize = 256 << 20;
+
+/// Columns forward-solved at once (their values lie on elimination-tree paths only).
+const FORWARD_BATCH: usize = 256;
+
+/// Products Wᵀ W of one block below this many multiply-adds run single-threaded.
+const PARALLEL_PRODUCT: usize = 1 << 20;
 
 /// One contact's change since the reference: of its block coefficients (ΔD) and of its load
 /// coefficients (Δχ, the load G χ including the products of the block with prescribed DOFs).
@@ -78,6 +85,26 @@ pub(crate) struct LowRankCorrection {
     owned: Vec<Vec<usize>>,
     /// S = Uᵀ A₀⁻¹ U (order `columns.len()`).
     s: Mat<f64>,
+    /// How the columns of S are computed on this A₀.
+    mode: ColumnMode,
+}
+
+/// How S's columns are computed.
+enum ColumnMode {
+    /// Not known yet (no columns).
+    Unknown,
+    /// S = Wᵀ W from the backend's sparse forward solves W = L⁻¹ P Ŝ U, kept block by block
+    /// (block of L → its rows, the columns reaching it, their values).
+    Forward(HashMap<usize, StoredBlock>),
+    /// Full solves A₀⁻¹ U, many right-hand sides at a time.
+    Solves,
+}
+
+/// The rows of W in one block of L, for every column so far that reaches it.
+struct StoredBlock {
+    rows: usize,
+    columns: Vec<usize>,
+    values: Vec<f64>,
 }
 
 /// The factorized capacitance matrix I + E S of one set of changes.
@@ -141,6 +168,7 @@ impl LowRankCorrection {
             columns: Vec::new(),
             owned: vec![Vec::new(); contacts],
             s: Mat::zeros(0, 0),
+            mode: ColumnMode::Unknown,
         }
     }
 
@@ -154,6 +182,7 @@ impl LowRankCorrection {
         self.columns.clear();
         self.owned.iter_mut().for_each(Vec::clear);
         self.s = Mat::zeros(0, 0);
+        self.mode = ColumnMode::Unknown;
     }
 
     /// Columns of U so far.
@@ -198,6 +227,24 @@ impl LowRankCorrection {
         let total = self.columns.len();
         let n = self.n;
         self.s.resize_with(total, total, |_, _| 0.0);
+        if !matches!(self.mode, ColumnMode::Solves) {
+            for start in (first..total).step_by(FORWARD_BATCH) {
+                let end = (start + FORWARD_BATCH).min(total);
+                match a0.forward_solve_sparse(&self.columns[start..end]) {
+                    Ok(w) => self.add_forward(start, w),
+                    Err(SolverError::Unavailable { .. })
+                        if matches!(self.mode, ColumnMode::Unknown) =>
+                    {
+                        self.mode = ColumnMode::Solves;
+                        break;
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+            if !matches!(self.mode, ColumnMode::Solves) {
+                return Ok(());
+            }
+        }
         for start in (first..total).step_by(batch) {
             let end = (start + batch).min(total);
             let k = end - start;
@@ -225,6 +272,56 @@ impl LowRankCorrection {
             }
         }
         Ok(())
+    }
+
+    /// Adds S's entries for the columns `start..` from their forward solves `w`:
+    /// S = Wᵀ W block by block of L, each block's new columns against all its columns.
+    fn add_forward(&mut self, start: usize, w: ForwardColumns) {
+        if matches!(self.mode, ColumnMode::Unknown) {
+            self.mode = ColumnMode::Forward(HashMap::new());
+        }
+        let ColumnMode::Forward(store) = &mut self.mode else {
+            return;
+        };
+        let mut product = Vec::new();
+        for blk in w.blocks {
+            let stored = store.entry(blk.block).or_insert_with(|| StoredBlock {
+                rows: blk.rows,
+                columns: Vec::new(),
+                values: Vec::new(),
+            });
+            let old = stored.columns.len();
+            stored.columns.extend(blk.columns.iter().map(|c| start + c));
+            stored.values.extend(blk.values);
+            let (rows, all) = (stored.rows, stored.columns.len());
+            let new = all - old;
+            let w_all = MatRef::from_column_major_slice(&stored.values, rows, all);
+            product.clear();
+            product.resize(all * new, 0.0);
+            let par = if rows * all * new > PARALLEL_PRODUCT {
+                faer::Par::rayon(0)
+            } else {
+                faer::Par::Seq
+            };
+            faer::linalg::matmul::matmul(
+                MatMut::from_column_major_slice_mut(&mut product, all, new),
+                faer::Accum::Replace,
+                w_all.transpose(),
+                w_all.subcols(old, new),
+                1.0,
+                par,
+            );
+            for (b, p) in product.chunks(all).enumerate() {
+                let col = stored.columns[old + b];
+                for (a, &v) in p.iter().enumerate() {
+                    let row = stored.columns[a];
+                    self.s[(row, col)] += v;
+                    if a < old {
+                        self.s[(col, row)] += v;
+                    }
+                }
+            }
+        }
     }
 
     /// Factorizes I + E S for `changes` (each contact's columns must be there: see
@@ -464,9 +561,16 @@ mod tests {
     /// The Woodbury solve equals a dense solve of A₀ + U E Uᵀ (a path-graph Laplacian plus a
     /// diagonal as A₀, contacts of 2, 3 and 6 columns on random DOFs, E nonsymmetric and
     /// indefinite as a stick → slip change is) to 1e-10, and S grown in two steps equals
-    /// Uᵀ A₀⁻¹ U computed at once.
+    /// Uᵀ A₀⁻¹ U computed at once: with S from sparse forward solves (faer Cholesky) and from
+    /// full solves (faer LU, which has no forward solve).
     #[test]
     fn woodbury_solve_matches_a_dense_solve_of_the_modified_matrix() {
+        for (kind, forward) in [(SolverKind::FaerCholesky, true), (SolverKind::FaerLu, false)] {
+            woodbury_solve_with(kind, forward);
+        }
+    }
+
+    fn woodbury_solve_with(kind: SolverKind, forward: bool) {
         let n = 60;
         let mut triplets = Vec::new();
         for i in 0..n {
@@ -478,7 +582,7 @@ mod tests {
         }
         let a0 = CscMatrix::from_triplets(n, n, &triplets).expect("matrix");
         let mut solver =
-            make_solver(SolverKind::FaerCholesky, &Ordering::Auto, Vec::new()).expect("solver");
+            make_solver(kind, &Ordering::Auto, Vec::new()).expect("solver");
         solver.analyze(a0.as_ref()).expect("analyze");
         solver.factorize(a0.as_ref()).expect("factorize");
         // A pseudo-random but fixed column for (contact, basis row).
@@ -529,6 +633,11 @@ mod tests {
             .extend(solver.as_mut(), &changes, column)
             .expect("extend");
         assert_eq!(low_rank.len(), 11);
+        assert_eq!(
+            matches!(low_rank.mode, ColumnMode::Forward(_)),
+            forward,
+            "{kind:?}"
+        );
         // Dense A = A₀ + Σ U_c E_c U_cᵀ.
         let mut dense = DMatrix::<f64>::zeros(n, n);
         for &(i, j, v) in &triplets {

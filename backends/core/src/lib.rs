@@ -19,6 +19,7 @@
 mod csc;
 mod error;
 mod factor_pcg;
+mod forward;
 mod lower;
 mod ordering;
 mod residual;
@@ -27,6 +28,7 @@ mod solver;
 pub use csc::{CscMatrix, CscRef, PatternFingerprint};
 pub use error::{SolverError, StopReason};
 pub use factor_pcg::{pcg_with_factor, FactorPcg};
+pub use forward::{ForwardBlock, ForwardColumns};
 pub use lower::LowerTriangle;
 pub use ordering::{compute_ordering, Ordering, Permutation};
 pub use residual::{

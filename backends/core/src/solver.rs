@@ -1,6 +1,6 @@
 //! The [`LinearSolver`] trait: analyze / factorize / solve.
 
-use crate::{CscRef, SolverError, StopReason};
+use crate::{CscRef, ForwardColumns, SolverError, StopReason};
 
 /// What a backend can do.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -75,6 +75,22 @@ pub trait LinearSolver: Send {
         Err(SolverError::Unavailable {
             backend: self.name(),
             reason: "no low-rank update or downdate of the factor".into(),
+        })
+    }
+
+    /// The forward half W = L⁻¹ P Ŝ B of a solve for the sparse columns B (`columns[j]` lists
+    /// column j's (row, value) entries, rows distinct) with the current symmetric factorization
+    /// A = Ŝ⁻¹ Pᵀ L Lᵀ P Ŝ⁻¹, so that Bᵀ A⁻¹ B = Wᵀ W at the cost of the elimination-tree paths
+    /// of B's nonzeros instead of two full triangular solves per column. Backends without it
+    /// return [`SolverError::Unavailable`] (the default).
+    fn forward_solve_sparse(
+        &mut self,
+        columns: &[Vec<(usize, f64)>],
+    ) -> Result<ForwardColumns, SolverError> {
+        let _ = columns;
+        Err(SolverError::Unavailable {
+            backend: self.name(),
+            reason: "no sparse forward solve".into(),
         })
     }
 }

@@ -5,6 +5,7 @@
 mod cholesky;
 mod lu;
 mod pivots;
+mod sparse_forward;
 
 pub use cholesky::{CholeskyVariant, FaerCholesky};
 pub use lu::FaerLu;
