@@ -6,6 +6,7 @@
 //! which is how a mechanism (a fiber held by nothing) shows up instead of a garbage solution.
 
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
+use crate::block_solve::{solve_in_place as block_solve, SolveSchedule};
 use crate::sparse_forward::BlockTree;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -53,6 +54,8 @@ struct Analysis {
     symbolic: SymbolicCholesky<usize>,
     /// The block tree of L for sparse forward solves.
     tree: BlockTree,
+    /// Its blocks per thread for solves with one right-hand side.
+    schedule: SolveSchedule,
     /// The inverse of the permutation faer solves with (x[new] = b[fwd[new]]), `inv[old] = new`.
     factor_inv: Vec<usize>,
 }
@@ -97,6 +100,13 @@ impl FaerCholesky {
         self.analysis.as_ref().map(|a| !is_simplicial(&a.symbolic))
     }
 
+    /// The symbolic factor, L's values, the inverse permutation and the scaling (tests).
+    #[cfg(test)]
+    pub(crate) fn factor_parts(&self) -> (&SymbolicCholesky<usize>, &[f64], &[usize], &[f64]) {
+        let (an, f) = (self.analysis.as_ref().unwrap(), self.factor.as_ref().unwrap());
+        (&an.symbolic, &f.l_values, &an.factor_inv, &f.scale)
+    }
+
     /// Runs single-threaded.
     pub fn sequential(mut self) -> Self {
         self.par = Par::Seq;
@@ -121,6 +131,14 @@ impl FaerCholesky {
             code: -1,
             message: format!("symbolic factorization failed: {e:?}"),
         })
+    }
+}
+
+/// Threads of `par`.
+fn threads(par: Par) -> usize {
+    match par {
+        Par::Seq => 1,
+        Par::Rayon(t) => t.get(),
     }
 }
 
@@ -175,6 +193,7 @@ impl LinearSolver for FaerCholesky {
             }
         };
         let (nnz_l, flops) = fill_and_flops(&symbolic);
+        let tree = BlockTree::of(&symbolic);
         let info = AnalyzeInfo {
             n,
             nnz_a: a.nnz(),
@@ -187,7 +206,8 @@ impl LinearSolver for FaerCholesky {
             fingerprint: a.fingerprint(),
             lower: lower_tri,
             perm,
-            tree: BlockTree::of(&symbolic),
+            schedule: SolveSchedule::new(&tree, &symbolic, threads(self.par)),
+            tree,
             factor_inv: match symbolic.perm() {
                 Some(p) => p.arrays().1.to_vec(),
                 None => (0..n).collect(),
@@ -304,7 +324,7 @@ impl LinearSolver for FaerCholesky {
             for (old, &new) in an.factor_inv.iter().enumerate() {
                 x[new] = rhs[old] * f.scale[old];
             }
-            an.tree.solve_in_place(&an.symbolic, &f.l_values, &mut x);
+            block_solve(&an.schedule, &an.symbolic, &f.l_values, &mut x);
             for (old, &new) in an.factor_inv.iter().enumerate() {
                 rhs[old] = x[new] * f.scale[old];
             }
@@ -315,10 +335,7 @@ impl LinearSolver for FaerCholesky {
         }
         // Several right-hand sides: column groups solved side by side, one per thread (faer's
         // supernodal solve gains little from more columns at a time or from a parallel kernel).
-        let threads = match self.par {
-            Par::Seq => 1,
-            Par::Rayon(t) => t.get(),
-        };
+        let threads = threads(self.par);
         let groups = threads.min(nrhs).max(1);
         let (par, per_group) = if groups > 1 {
             (Par::Seq, nrhs.div_ceil(groups))

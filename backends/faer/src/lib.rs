@@ -2,6 +2,7 @@
 //! ([`FaerCholesky`], LLᵀ or LDLᵀ, symbolic analysis reused) and LU ([`FaerLu`], for the
 //! nonsymmetric systems of Coulomb sliding). No system packages needed.
 
+mod block_solve;
 mod cholesky;
 mod lu;
 mod pivots;

@@ -8,7 +8,7 @@ use faer::{Accum, MatMut, MatRef, Par};
 use std::ops::Range;
 use fibercell_solver::{ForwardBlock, ForwardColumns, SolverError};
 
-const NONE: usize = usize::MAX;
+pub(crate) const NONE: usize = usize::MAX;
 
 /// Products of a block below which the dense kernels run single-threaded.
 const PARALLEL_FLOPS: usize = 1 << 20;
@@ -16,22 +16,22 @@ const PARALLEL_FLOPS: usize = 1 << 20;
 /// The block tree of a factor: faer's supernodes, or single columns for a simplicial factor.
 pub(crate) struct BlockTree {
     /// The block holding each column of L.
-    block_of: Vec<usize>,
+    pub(crate) block_of: Vec<usize>,
     /// Each block's parent (the block of its first off-diagonal row), `NONE` at a root.
-    parent: Vec<usize>,
+    pub(crate) parent: Vec<usize>,
 }
 
 /// One block of L: first column, width, off-diagonal rows, values (rows × width, column-major,
 /// the diagonal block on top).
-struct Block<'a> {
-    begin: usize,
-    width: usize,
-    pattern: &'a [usize],
-    values: &'a [f64],
+pub(crate) struct Block<'a> {
+    pub(crate) begin: usize,
+    pub(crate) width: usize,
+    pub(crate) pattern: &'a [usize],
+    pub(crate) values: &'a [f64],
 }
 
 /// Block `s`: first column, width, off-diagonal rows and the range of its values.
-fn shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> (usize, usize, &[usize], Range<usize>) {
+pub(crate) fn shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> (usize, usize, &[usize], Range<usize>) {
     match symbolic.raw() {
         SymbolicCholeskyRaw::Simplicial(f) => {
             let (p, q) = (f.col_ptr()[s], f.col_ptr()[s + 1]);
@@ -46,7 +46,7 @@ fn shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> (usize, usize, &[usize
     }
 }
 
-fn block<'a>(symbolic: &'a SymbolicCholesky<usize>, values: &'a [f64], s: usize) -> Block<'a> {
+pub(crate) fn block<'a>(symbolic: &'a SymbolicCholesky<usize>, values: &'a [f64], s: usize) -> Block<'a> {
     let (begin, width, pattern, range) = shape(symbolic, s);
     Block {
         begin,
@@ -54,24 +54,6 @@ fn block<'a>(symbolic: &'a SymbolicCholesky<usize>, values: &'a [f64], s: usize)
         pattern,
         values: &values[range],
     }
-}
-
-/// Σ aᵢ bᵢ with four partial sums (vectorizable).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 4];
-    let (ac, bc) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ac
-        .remainder()
-        .iter()
-        .zip(bc.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ac.zip(bc) {
-        for k in 0..4 {
-            acc[k] += x[k] * y[k];
-        }
-    }
-    acc.iter().sum::<f64>() + tail
 }
 
 fn block_count(symbolic: &SymbolicCholesky<usize>) -> usize {
@@ -98,51 +80,6 @@ impl BlockTree {
             .map(|r| r.map_or(NONE, |r| block_of[r]))
             .collect();
         BlockTree { block_of, parent }
-    }
-
-    /// Solves L Lᵀ x = b in place (one right-hand side, factor order): per block a triangular
-    /// solve and one pass over its rows below, forward then backward — each block of L read
-    /// once per direction with contiguous inner loops.
-    pub(crate) fn solve_in_place(
-        &self,
-        symbolic: &SymbolicCholesky<usize>,
-        values: &[f64],
-        x: &mut [f64],
-    ) {
-        let mut below = Vec::new();
-        for s in 0..self.parent.len() {
-            let b = block(symbolic, values, s);
-            let ld = b.width + b.pattern.len();
-            below.clear();
-            below.resize(b.pattern.len(), 0.0);
-            let top = &mut x[b.begin..b.begin + b.width];
-            for c in 0..b.width {
-                let col = &b.values[c * ld..(c + 1) * ld];
-                let xc = top[c] / col[c];
-                top[c] = xc;
-                for (t, l) in top[c + 1..].iter_mut().zip(&col[c + 1..b.width]) {
-                    *t -= l * xc;
-                }
-                for (t, l) in below.iter_mut().zip(&col[b.width..]) {
-                    *t += l * xc;
-                }
-            }
-            for (&row, t) in b.pattern.iter().zip(&below) {
-                x[row] -= t;
-            }
-        }
-        for s in (0..self.parent.len()).rev() {
-            let b = block(symbolic, values, s);
-            let ld = b.width + b.pattern.len();
-            below.clear();
-            below.extend(b.pattern.iter().map(|&row| x[row]));
-            let top = &mut x[b.begin..b.begin + b.width];
-            for c in (0..b.width).rev() {
-                let col = &b.values[c * ld..(c + 1) * ld];
-                let sum = dot(&col[c + 1..b.width], &top[c + 1..]) + dot(&col[b.width..], &below);
-                top[c] = (top[c] - sum) / col[c];
-            }
-        }
     }
 
     /// W = L⁻¹ P Ŝ B for the sparse columns `columns` (original row numbering), `inv` the
@@ -270,12 +207,12 @@ impl BlockTree {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use crate::{CholeskyVariant, FaerCholesky};
     use fibercell_solver::{CscMatrix, LinearSolver, Ordering, SolverError};
 
     /// A k³ grid Laplacian with edge weights and diagonal scales spread over four decades.
-    fn grid(k: usize) -> CscMatrix {
+    pub(crate) fn grid(k: usize) -> CscMatrix {
         let id = |x: usize, y: usize, z: usize| (x * k + y) * k + z;
         let weight = |a: usize, b: usize| 1.0 + ((a * 7919 + b * 104_729) % 97) as f64 / 10.0;
         let scale = |a: usize| 10f64.powi((a % 5) as i32 - 2);
