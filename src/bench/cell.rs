@@ -349,8 +349,7 @@ fn low_rank_switch(
     let error = backward_error(a, &x, rhs);
     // The next solve as in a stick/slip iteration: the load changed within the switched
     // contacts' columns, solved from A₀⁻¹ b₀ of the increment (known) with one solve.
-    let mut x0 = rhs.to_vec();
-    a0.solve_in_place(&mut x0, 1)?;
+    let x0 = low_rank.reference(a0, rhs.to_vec())?;
     let load = vec![1.0; cap.order()];
     let t = Instant::now();
     let cap = low_rank.capacitance(&changes);

@@ -17,7 +17,7 @@
 //! Otherwise systems with a Coulomb-sliding contact are nonsymmetric and go to LU, all others
 //! to the chosen symmetric backend.
 
-use super::low_rank::{Capacitance, ContactChange, LowRankCorrection, SparseColumn};
+use super::low_rank::{Capacitance, ContactChange, LowRankCorrection, Reference, SparseColumn};
 use super::static_solve::{backward_tolerance, check_backward_error, locate};
 use super::{check_supported_with, make_solver, IncrementTimings, SolveOptions, SolverKind};
 use crate::assembly::{
@@ -836,7 +836,7 @@ pub(crate) fn run_incremental(
     // reference A₀ of the low-rank solves), and the correction accumulated on it.
     let mut reference: Option<Vec<ReferenceBlock>> = None;
     // A₀⁻¹ b₀ for this increment, b₀ the load with every contact as in the reference.
-    let mut reference_solution: Option<Vec<f64>>;
+    let mut reference_solution: Option<Reference>;
     let mut low_rank = LowRankCorrection::new(n_free, pairs.len());
     let mut reference_values = vec![0.0; pattern.nnz()];
     // Per contact, its block columns on prescribed DOFs (their products go to the load).
@@ -1051,10 +1051,9 @@ pub(crate) fn run_incremental(
                         None => {
                             // b₀ = b − U Δχ, the load with every contact as in the reference.
                             let shift = low_rank.spread(&cap, &load);
-                            let mut x0: Vec<f64> =
+                            let b0: Vec<f64> =
                                 rhs.iter().zip(&shift).map(|(b, s)| b - s).collect();
-                            a0.solve_in_place(&mut x0, 1).map_err(locate)?;
-                            x0
+                            low_rank.reference(a0.as_mut(), b0).map_err(locate)?
                         }
                     };
                     let first = low_rank.solve_from(a0.as_mut(), &cap, &x0, &load);
@@ -1156,7 +1155,7 @@ pub(crate) fn run_incremental(
                     let (x, r) = solve_checked(solver.as_mut(), a, &rhs, 1).map_err(locate)?;
                     if refactorized {
                         // The reference's own load: A₀⁻¹ b₀ of this increment.
-                        reference_solution = Some(x.clone());
+                        reference_solution = Some(Reference::Full(x.clone()));
                     }
                     (x, Some(r))
                 }

@@ -102,6 +102,7 @@ enum ColumnMode {
 
 /// The rows of W in one block of L, for every column so far that reaches it.
 struct StoredBlock {
+    first_row: usize,
     rows: usize,
     columns: Vec<usize>,
     values: Vec<f64>,
@@ -286,6 +287,7 @@ impl LowRankCorrection {
         let mut product = Vec::new();
         for blk in w.blocks {
             let stored = store.entry(blk.block).or_insert_with(|| StoredBlock {
+                first_row: blk.first_row,
                 rows: blk.rows,
                 columns: Vec::new(),
                 values: Vec::new(),
@@ -449,64 +451,149 @@ impl LowRankCorrection {
     }
 
     /// x = (A₀ + U E Uᵀ)⁻¹ b for the changes factorized in `cap`, `a0` the factorization of A₀:
-    /// two solves with A₀.
+    /// two solves with A₀, or — when S came from forward solves W = L⁻¹ P Ŝ U — one forward
+    /// and one backward half: f = L⁻¹ P Ŝ b, Uᵀ A₀⁻¹ b = Wᵀ f, x = Ŝ Pᵀ L⁻ᵀ (f − W z).
     pub(crate) fn solve(
         &self,
         a0: &mut dyn LinearSolver,
         cap: &Capacitance,
         b: &[f64],
     ) -> Result<Vec<f64>, SolverError> {
-        let mut x = b.to_vec();
-        a0.solve_in_place(&mut x, 1)?;
-        let y: Vec<f64> = cap
-            .active
-            .iter()
-            .map(|&c| dot(&self.columns[c], &x))
-            .collect();
-        self.correct(a0, cap, x, y, None)
+        let reference = self.reference(a0, b.to_vec())?;
+        self.solve_from(a0, cap, &reference, &vec![0.0; cap.order()])
     }
 
-    /// The same for b = b₀ + U Δχ, from x₀ = A₀⁻¹ b₀ and the load change `load` on the columns
-    /// of `cap` ([`LowRankCorrection::active_load`]): one solve with A₀, as
-    /// A₀⁻¹ b = x₀ + A₀⁻¹ U Δχ and Uᵀ A₀⁻¹ b = Uᵀ x₀ + S Δχ.
+    /// A₀⁻¹ b₀ for later [`LowRankCorrection::solve_from`]: its forward half when S comes from
+    /// forward solves, else the full solution.
+    pub(crate) fn reference(
+        &self,
+        a0: &mut dyn LinearSolver,
+        mut b0: Vec<f64>,
+    ) -> Result<Reference, SolverError> {
+        if matches!(self.mode, ColumnMode::Forward(_)) {
+            a0.solve_lower_in_place(&mut b0)?;
+            Ok(Reference::Forward(b0))
+        } else {
+            a0.solve_in_place(&mut b0, 1)?;
+            Ok(Reference::Full(b0))
+        }
+    }
+
+    /// x = (A₀ + U E Uᵀ)⁻¹ b for b = b₀ + U Δχ, from A₀⁻¹ b₀ (`reference`) and the load change
+    /// `load` on the columns of `cap` ([`LowRankCorrection::active_load`]): one solve with A₀
+    /// (one backward half from a forward reference), as A₀⁻¹ b = A₀⁻¹ b₀ + A₀⁻¹ U Δχ and
+    /// Uᵀ A₀⁻¹ b = Uᵀ A₀⁻¹ b₀ + S Δχ.
     pub(crate) fn solve_from(
         &self,
         a0: &mut dyn LinearSolver,
         cap: &Capacitance,
-        x0: &[f64],
+        reference: &Reference,
         load: &[f64],
     ) -> Result<Vec<f64>, SolverError> {
+        let projected: Vec<f64> = match reference {
+            Reference::Full(x0) => cap
+                .active
+                .iter()
+                .map(|&c| dot(&self.columns[c], x0))
+                .collect(),
+            Reference::Forward(f0) => {
+                let all = self.forward_transpose(f0);
+                cap.active.iter().map(|&c| all[c]).collect()
+            }
+        };
         let y: Vec<f64> = cap
             .active
             .iter()
-            .map(|&c| {
-                dot(&self.columns[c], x0)
-                    + cap
-                        .active
-                        .iter()
-                        .zip(load)
-                        .map(|(&l, v)| self.s[(c, l)] * v)
-                        .sum::<f64>()
+            .zip(projected)
+            .map(|(&c, p)| {
+                p + cap
+                    .active
+                    .iter()
+                    .zip(load)
+                    .map(|(&l, v)| self.s[(c, l)] * v)
+                    .sum::<f64>()
             })
             .collect();
-        self.correct(a0, cap, x0.to_vec(), y, Some(load))
+        let z = cap.solve(y)?;
+        // v = Δχ − z on the active columns, as a coefficient of every column of U.
+        let mut v = vec![0.0; self.columns.len()];
+        for ((&c, l), zj) in cap.active.iter().zip(load).zip(&z) {
+            v[c] += l - zj;
+        }
+        match (reference, &self.mode) {
+            (Reference::Forward(f0), _) => {
+                let mut f = f0.clone();
+                self.forward_spread(&v, &mut f);
+                a0.solve_upper_in_place(&mut f)?;
+                Ok(f)
+            }
+            (Reference::Full(x0), ColumnMode::Forward(_)) => {
+                let mut w = vec![0.0; self.n];
+                self.forward_spread(&v, &mut w);
+                a0.solve_upper_in_place(&mut w)?;
+                Ok(x0.iter().zip(&w).map(|(x, w)| x + w).collect())
+            }
+            (Reference::Full(x0), _) => {
+                let mut w = vec![0.0; self.n];
+                for (col, &vj) in self.columns.iter().zip(&v) {
+                    if vj != 0.0 {
+                        col.iter().for_each(|&(i, u)| w[i] += u * vj);
+                    }
+                }
+                a0.solve_in_place(&mut w, 1)?;
+                Ok(x0.iter().zip(&w).map(|(x, w)| x + w).collect())
+            }
+        }
     }
 
-    /// x + A₀⁻¹ U (Δχ − z) with (I + E S) z = E y (Δχ = 0 when `load` is `None`).
-    fn correct(
-        &self,
-        a0: &mut dyn LinearSolver,
-        cap: &Capacitance,
-        mut x: Vec<f64>,
-        y: Vec<f64>,
-        load: Option<&[f64]>,
-    ) -> Result<Vec<f64>, SolverError> {
-        let r = cap.order();
+    /// Wᵀ f for every column (f in the factor's row order); zeros without forward solves.
+    fn forward_transpose(&self, f: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.columns.len()];
+        if let ColumnMode::Forward(store) = &self.mode {
+            for blk in store.values() {
+                let rows = &f[blk.first_row..blk.first_row + blk.rows];
+                for (values, &c) in blk.values.chunks(blk.rows).zip(&blk.columns) {
+                    out[c] += values.iter().zip(rows).map(|(w, x)| w * x).sum::<f64>();
+                }
+            }
+        }
+        out
+    }
+
+    /// out += W v (factor row order), `v` a coefficient per column; nothing without forward
+    /// solves.
+    fn forward_spread(&self, v: &[f64], out: &mut [f64]) {
+        if let ColumnMode::Forward(store) = &self.mode {
+            for blk in store.values() {
+                let rows = &mut out[blk.first_row..blk.first_row + blk.rows];
+                for (values, &c) in blk.values.chunks(blk.rows).zip(&blk.columns) {
+                    if v[c] != 0.0 {
+                        rows.iter_mut().zip(values).for_each(|(o, w)| *o += w * v[c]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A₀⁻¹ b₀ as [`LowRankCorrection::solve_from`] starts from it.
+#[derive(Clone, Debug)]
+pub(crate) enum Reference {
+    /// The solution.
+    Full(Vec<f64>),
+    /// Its forward half L⁻¹ P Ŝ b₀ (factor row order).
+    Forward(Vec<f64>),
+}
+
+impl Capacitance {
+    /// z with (I + E S) z = E y.
+    fn solve(&self, y: Vec<f64>) -> Result<Vec<f64>, SolverError> {
+        let r = self.order();
         let mut z = Vec::with_capacity(r);
-        match &cap.factor {
+        match &self.factor {
             CapacitanceFactor::Lu(lu) => {
                 let mut offset = 0;
-                for (cols, e) in &cap.blocks {
+                for (cols, e) in &self.blocks {
                     let k = cols.len();
                     let u = &y[offset..offset + k];
                     z.extend((0..k).map(|i| (0..k).map(|l| e[i * k + l] * u[l]).sum::<f64>()));
@@ -518,7 +605,7 @@ impl LowRankCorrection {
                 // E = −C Cᵀ: z = −C t with (I − Cᵀ S C) t = Cᵀ y.
                 let mut t = Vec::with_capacity(r);
                 let mut offset = 0;
-                for (b, (cols, _)) in cap.blocks.iter().enumerate() {
+                for (b, (cols, _)) in self.blocks.iter().enumerate() {
                     let k = cols.len();
                     let u = &y[offset..offset + k];
                     t.extend((0..k).map(|a| (0..k).map(|i| c[b][i * k + a] * u[i]).sum::<f64>()));
@@ -526,7 +613,7 @@ impl LowRankCorrection {
                 }
                 llt.solve_in_place(MatMut::from_column_major_slice_mut(&mut t, r, 1));
                 let mut offset = 0;
-                for (b, (cols, _)) in cap.blocks.iter().enumerate() {
+                for (b, (cols, _)) in self.blocks.iter().enumerate() {
                     let k = cols.len();
                     let tb = &t[offset..offset + k];
                     z.extend((0..k).map(|i| -(0..k).map(|a| c[b][i * k + a] * tb[a]).sum::<f64>()));
@@ -540,14 +627,7 @@ impl LowRankCorrection {
                 index: i,
             });
         }
-        let v: Vec<f64> = match load {
-            Some(load) => load.iter().zip(&z).map(|(l, zj)| l - zj).collect(),
-            None => z.iter().map(|zj| -zj).collect(),
-        };
-        let mut w = self.spread(cap, &v);
-        a0.solve_in_place(&mut w, 1)?;
-        x.iter_mut().zip(&w).for_each(|(xi, wi)| *xi += wi);
-        Ok(x)
+        Ok(z)
     }
 }
 
@@ -701,15 +781,21 @@ mod tests {
         let b1: Vec<f64> = b.iter().zip(&spread).map(|(p, q)| p + q).collect();
         let mut x0 = b.clone();
         solver.solve_in_place(&mut x0, 1).expect("solve");
-        let x1 = low_rank
-            .solve_from(solver.as_mut(), &cap, &x0, &load)
-            .expect("solve");
         let expected = dense
             .lu()
             .solve(&DVector::from_vec(b1))
             .expect("nonsingular");
-        let err = (DVector::from_vec(x1) - &expected).amax() / expected.amax();
-        assert!(err <= 1e-10, "relative error from x₀: {err}");
+        // From the full x₀ and from the reference the correction keeps (its forward half
+        // when S came from forward solves).
+        let kept = low_rank.reference(solver.as_mut(), b.clone()).expect("solve");
+        assert_eq!(matches!(kept, Reference::Forward(_)), forward);
+        for reference in [Reference::Full(x0), kept] {
+            let x1 = low_rank
+                .solve_from(solver.as_mut(), &cap, &reference, &load)
+                .expect("solve");
+            let err = (DVector::from_vec(x1) - &expected).amax() / expected.amax();
+            assert!(err <= 1e-10, "relative error from x₀: {err}");
+        }
         // Springs removed (E = −F, F symmetric positive semi-definite, of rank 1 for contact 0)
         // keep A positive definite: the Cholesky capacitance, the same result as a dense solve.
         let removed: Vec<ContactChange> = [(0usize, 2usize), (1, 6), (2, 3)]

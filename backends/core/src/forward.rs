@@ -19,6 +19,8 @@ pub struct ForwardColumns {
 pub struct ForwardBlock {
     /// The block's index in its factor.
     pub block: usize,
+    /// Its first row in the factor's row order (it holds `first_row..first_row + rows`).
+    pub first_row: usize,
     /// Its rows (columns of L).
     pub rows: usize,
     /// The columns of B that reach it, ascending.

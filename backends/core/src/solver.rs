@@ -93,6 +93,28 @@ pub trait LinearSolver: Send {
             reason: "no sparse forward solve".into(),
         })
     }
+
+    /// The forward half of a solve with the symmetric factorization A = Ŝ⁻¹ Pᵀ L Lᵀ P Ŝ⁻¹ for
+    /// one right-hand side: `x` ← L⁻¹ P Ŝ x, in the factor's row order (see
+    /// [`LinearSolver::solve_upper_in_place`]; the same space as
+    /// [`LinearSolver::forward_solve_sparse`]'s blocks). Default: [`SolverError::Unavailable`].
+    fn solve_lower_in_place(&mut self, x: &mut [f64]) -> Result<(), SolverError> {
+        let _ = x;
+        Err(SolverError::Unavailable {
+            backend: self.name(),
+            reason: "no half solves".into(),
+        })
+    }
+
+    /// The backward half: `y` (factor order) ← Ŝ Pᵀ L⁻ᵀ y, so that the two halves in turn are
+    /// a solve with A. Default: [`SolverError::Unavailable`].
+    fn solve_upper_in_place(&mut self, y: &mut [f64]) -> Result<(), SolverError> {
+        let _ = y;
+        Err(SolverError::Unavailable {
+            backend: self.name(),
+            reason: "no half solves".into(),
+        })
+    }
 }
 
 impl dyn LinearSolver {

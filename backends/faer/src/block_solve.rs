@@ -187,6 +187,17 @@ pub(crate) fn solve_in_place(
     values: &[f64],
     x: &mut [f64],
 ) {
+    forward_in_place(schedule, symbolic, values, x);
+    backward_in_place(schedule, symbolic, values, x);
+}
+
+/// x ← L⁻¹ x (factor order).
+pub(crate) fn forward_in_place(
+    schedule: &SolveSchedule,
+    symbolic: &SymbolicCholesky<usize>,
+    values: &[f64],
+    x: &mut [f64],
+) {
     let shared = Shared(x.as_mut_ptr());
     let top_index = &schedule.top_index;
     // Forward: the subtrees, their updates of top rows kept per thread.
@@ -231,7 +242,16 @@ pub(crate) fn solve_in_place(
             x[row] -= t;
         }
     }
-    // Backward: the top blocks, then the subtrees (reading the final top rows).
+}
+
+/// x ← L⁻ᵀ x (factor order): the top blocks, then the subtrees (reading the final top rows).
+pub(crate) fn backward_in_place(
+    schedule: &SolveSchedule,
+    symbolic: &SymbolicCholesky<usize>,
+    values: &[f64],
+    x: &mut [f64],
+) {
+    let mut below = Vec::new();
     for &s in schedule.top.iter().rev() {
         let b = block(symbolic, values, s);
         below.clear();

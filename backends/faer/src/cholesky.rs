@@ -6,7 +6,9 @@
 //! which is how a mechanism (a fiber held by nothing) shows up instead of a garbage solution.
 
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
-use crate::block_solve::{solve_in_place as block_solve, SolveSchedule};
+use crate::block_solve::{
+    backward_in_place, forward_in_place, solve_in_place as block_solve, SolveSchedule,
+};
 use crate::sparse_forward::BlockTree;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -105,6 +107,21 @@ impl FaerCholesky {
     pub(crate) fn factor_parts(&self) -> (&SymbolicCholesky<usize>, &[f64], &[usize], &[f64]) {
         let (an, f) = (self.analysis.as_ref().unwrap(), self.factor.as_ref().unwrap());
         (&an.symbolic, &f.l_values, &an.factor_inv, &f.scale)
+    }
+
+    /// The analysis and an LLᵀ factor, for the half and sparse solves.
+    fn llt_parts(&self) -> Result<(&Analysis, &Factor), SolverError> {
+        let (an, f) = match (&self.analysis, &self.factor) {
+            (Some(a), Some(f)) => (a, f),
+            _ => return Err(SolverError::OutOfOrder("solve", "factorize")),
+        };
+        if self.variant != CholeskyVariant::Llt {
+            return Err(SolverError::Unavailable {
+                backend: "faer-cholesky",
+                reason: "half and sparse solves need the LLᵀ variant".into(),
+            });
+        }
+        Ok((an, f))
     }
 
     /// Runs single-threaded.
@@ -371,20 +388,37 @@ impl LinearSolver for FaerCholesky {
         Ok(SolveInfo::default())
     }
 
+    fn solve_lower_in_place(&mut self, x: &mut [f64]) -> Result<(), SolverError> {
+        let (an, f) = self.llt_parts()?;
+        <dyn LinearSolver>::check_rhs(an.n, x, 1)?;
+        let mut y = vec![0.0; an.n];
+        for (old, &new) in an.factor_inv.iter().enumerate() {
+            y[new] = x[old] * f.scale[old];
+        }
+        forward_in_place(&an.schedule, &an.symbolic, &f.l_values, &mut y);
+        x.copy_from_slice(&y);
+        Ok(())
+    }
+
+    fn solve_upper_in_place(&mut self, y: &mut [f64]) -> Result<(), SolverError> {
+        let (an, f) = self.llt_parts()?;
+        <dyn LinearSolver>::check_rhs(an.n, y, 1)?;
+        backward_in_place(&an.schedule, &an.symbolic, &f.l_values, y);
+        let x: Vec<f64> = an
+            .factor_inv
+            .iter()
+            .zip(&f.scale)
+            .map(|(&new, s)| y[new] * s)
+            .collect();
+        y.copy_from_slice(&x);
+        Ok(())
+    }
+
     fn forward_solve_sparse(
         &mut self,
         columns: &[Vec<(usize, f64)>],
     ) -> Result<ForwardColumns, SolverError> {
-        let (an, f) = match (&self.analysis, &self.factor) {
-            (Some(a), Some(f)) => (a, f),
-            _ => return Err(SolverError::OutOfOrder("solve", "factorize")),
-        };
-        if self.variant != CholeskyVariant::Llt {
-            return Err(SolverError::Unavailable {
-                backend: self.name(),
-                reason: "the sparse forward solve needs the LLᵀ variant".into(),
-            });
-        }
+        let (an, f) = self.llt_parts()?;
         an.tree.forward(
             &an.symbolic,
             &f.l_values,

@@ -194,6 +194,7 @@ impl BlockTree {
             .zip(x)
             .map(|(&s, values_s)| ForwardBlock {
                 block: s,
+                first_row: shape(symbolic, s).0,
                 rows: shape(symbolic, s).1,
                 columns: std::mem::take(&mut members[s]),
                 values: values_s,
@@ -332,6 +333,48 @@ pub(crate) mod tests {
         }
     }
 
+    /// The half solves: the lower half of a dense column equals its sparse forward solve on
+    /// the blocks it reaches and vanishes elsewhere; lower then upper is a solve (1e-12).
+    #[test]
+    fn half_solves_match_the_sparse_forward_solve_and_compose_to_a_solve() {
+        for k in [4, 16] {
+            let a = grid(k);
+            let n = k * k * k;
+            let mut s = FaerCholesky::new(CholeskyVariant::Llt, Ordering::NestedDissection);
+            s.analyze(a.as_ref()).unwrap();
+            s.factorize(a.as_ref()).unwrap();
+            let b = columns(n);
+            let w = s.forward_solve_sparse(&b).unwrap();
+            for (j, col) in b.iter().enumerate() {
+                let mut dense = vec![0.0; n];
+                for &(i, v) in col {
+                    dense[i] = v;
+                }
+                let mut full = dense.clone();
+                s.solve_in_place(&mut full, 1).unwrap();
+                s.solve_lower_in_place(&mut dense).unwrap();
+                let big = dense.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
+                let mut seen = vec![false; n];
+                for blk in &w.blocks {
+                    if let Ok(c) = blk.columns.binary_search(&j) {
+                        let got = &blk.values[c * blk.rows..(c + 1) * blk.rows];
+                        for (r, g) in got.iter().enumerate() {
+                            let want = dense[blk.first_row + r];
+                            assert!((g - want).abs() <= 1e-12 * big, "k {k} col {j}");
+                            seen[blk.first_row + r] = true;
+                        }
+                    }
+                }
+                assert!(dense.iter().zip(&seen).all(|(v, s)| *s || *v == 0.0));
+                s.solve_upper_in_place(&mut dense).unwrap();
+                let big = full.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
+                for (x, y) in dense.iter().zip(&full) {
+                    assert!((x - y).abs() <= 1e-12 * big, "k {k} col {j}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn sparse_forward_solve_rejects_bad_columns_and_ldlt() {
         let a = grid(4);
@@ -353,6 +396,10 @@ pub(crate) mod tests {
         l.factorize(a.as_ref()).unwrap();
         assert!(matches!(
             l.forward_solve_sparse(&[vec![(0, 1.0)]]),
+            Err(SolverError::Unavailable { .. })
+        ));
+        assert!(matches!(
+            l.solve_lower_in_place(&mut [0.0; 64]),
             Err(SolverError::Unavailable { .. })
         ));
     }
