@@ -48,6 +48,19 @@ impl Sink<'_> {
         slots: &[u32],
     ) -> Option<Matrix6> {
         let m = 6 * gnodes.len();
+        if !gnodes.contains(&self.driver) {
+            // No driver node (all blocks but a few): every entry goes to its slot.
+            for c in 0..m {
+                for r in 0..m {
+                    let s = slots[r * m + c];
+                    if s != NO_SLOT {
+                        // SAFETY: as below, the slot couples two nodes of this block only.
+                        unsafe { *self.values.get(s as usize) += k(r, c) };
+                    }
+                }
+            }
+            return None;
+        }
         let mut k_ee: Option<Matrix6> = None;
         let driver = |r: usize| gnodes[r / 6] == self.driver;
         let mut put = |r: usize, c: usize, v: f64| match (driver(r), driver(c)) {

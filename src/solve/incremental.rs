@@ -1051,8 +1051,7 @@ pub(crate) fn run_incremental(
                         None => {
                             // b₀ = b − U Δχ, the load with every contact as in the reference.
                             let shift = low_rank.spread(&cap, &load);
-                            let b0: Vec<f64> =
-                                rhs.iter().zip(&shift).map(|(b, s)| b - s).collect();
+                            let b0: Vec<f64> = rhs.iter().zip(&shift).map(|(b, s)| b - s).collect();
                             low_rank.reference(a0.as_mut(), b0).map_err(locate)?
                         }
                     };

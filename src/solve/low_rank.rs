@@ -16,9 +16,9 @@ use crate::contact::BlockCoefficients;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut, MatRef};
 use fibercell_solver::{ForwardColumns, LinearSolver, SolverError};
-use std::collections::HashMap;
 use nalgebra::Vector6;
 use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// The order in which a contact's jump rows become columns of U: the two tangents first (all a
 /// switch between stick and slip or a new slip direction needs), then the normal (Coulomb
@@ -568,7 +568,9 @@ impl LowRankCorrection {
                 let rows = &mut out[blk.first_row..blk.first_row + blk.rows];
                 for (values, &c) in blk.values.chunks(blk.rows).zip(&blk.columns) {
                     if v[c] != 0.0 {
-                        rows.iter_mut().zip(values).for_each(|(o, w)| *o += w * v[c]);
+                        rows.iter_mut()
+                            .zip(values)
+                            .for_each(|(o, w)| *o += w * v[c]);
                     }
                 }
             }
@@ -645,7 +647,10 @@ mod tests {
     /// full solves (faer LU, which has no forward solve).
     #[test]
     fn woodbury_solve_matches_a_dense_solve_of_the_modified_matrix() {
-        for (kind, forward) in [(SolverKind::FaerCholesky, true), (SolverKind::FaerLu, false)] {
+        for (kind, forward) in [
+            (SolverKind::FaerCholesky, true),
+            (SolverKind::FaerLu, false),
+        ] {
             woodbury_solve_with(kind, forward);
         }
     }
@@ -661,8 +666,7 @@ mod tests {
             }
         }
         let a0 = CscMatrix::from_triplets(n, n, &triplets).expect("matrix");
-        let mut solver =
-            make_solver(kind, &Ordering::Auto, Vec::new()).expect("solver");
+        let mut solver = make_solver(kind, &Ordering::Auto, Vec::new()).expect("solver");
         solver.analyze(a0.as_ref()).expect("analyze");
         solver.factorize(a0.as_ref()).expect("factorize");
         // A pseudo-random but fixed column for (contact, basis row).
@@ -787,7 +791,9 @@ mod tests {
             .expect("nonsingular");
         // From the full x₀ and from the reference the correction keeps (its forward half
         // when S came from forward solves).
-        let kept = low_rank.reference(solver.as_mut(), b.clone()).expect("solve");
+        let kept = low_rank
+            .reference(solver.as_mut(), b.clone())
+            .expect("solve");
         assert_eq!(matches!(kept, Reference::Forward(_)), forward);
         for reference in [Reference::Full(x0), kept] {
             let x1 = low_rank

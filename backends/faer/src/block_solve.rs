@@ -306,7 +306,10 @@ mod tests {
             let big = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for (old, &new) in inv.iter().enumerate() {
                 let got = x[new] * scale[old];
-                assert!((got - want[old]).abs() <= 1e-12 * big, "{threads} threads, row {old}");
+                assert!(
+                    (got - want[old]).abs() <= 1e-12 * big,
+                    "{threads} threads, row {old}"
+                );
             }
         }
     }

@@ -5,10 +5,10 @@
 //! `pivot_tolerance` is reported as [`SolverError::NotPositiveDefinite`] at the original column,
 //! which is how a mechanism (a fiber held by nothing) shows up instead of a garbage solution.
 
-use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
 use crate::block_solve::{
     backward_in_place, forward_in_place, solve_in_place as block_solve, SolveSchedule,
 };
+use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
 use crate::sparse_forward::BlockTree;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -22,8 +22,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use fibercell_solver::{
     compute_ordering, AnalyzeInfo, Capabilities, CscRef, ForwardColumns, LinearSolver,
-    LowerTriangle, Ordering,
-    PatternFingerprint, Permutation, SolveInfo, SolverError,
+    LowerTriangle, Ordering, PatternFingerprint, Permutation, SolveInfo, SolverError,
 };
 
 /// LLᵀ or LDLᵀ (no square roots; same sparsity).
@@ -105,7 +104,10 @@ impl FaerCholesky {
     /// The symbolic factor, L's values, the inverse permutation and the scaling (tests).
     #[cfg(test)]
     pub(crate) fn factor_parts(&self) -> (&SymbolicCholesky<usize>, &[f64], &[usize], &[f64]) {
-        let (an, f) = (self.analysis.as_ref().unwrap(), self.factor.as_ref().unwrap());
+        let (an, f) = (
+            self.analysis.as_ref().unwrap(),
+            self.factor.as_ref().unwrap(),
+        );
         (&an.symbolic, &f.l_values, &an.factor_inv, &f.scale)
     }
 

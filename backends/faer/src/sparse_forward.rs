@@ -5,8 +5,8 @@ use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::{Accum, MatMut, MatRef, Par};
-use std::ops::Range;
 use fibercell_solver::{ForwardBlock, ForwardColumns, SolverError};
+use std::ops::Range;
 
 pub(crate) const NONE: usize = usize::MAX;
 
@@ -31,7 +31,10 @@ pub(crate) struct Block<'a> {
 }
 
 /// Block `s`: first column, width, off-diagonal rows and the range of its values.
-pub(crate) fn shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> (usize, usize, &[usize], Range<usize>) {
+pub(crate) fn shape(
+    symbolic: &SymbolicCholesky<usize>,
+    s: usize,
+) -> (usize, usize, &[usize], Range<usize>) {
     match symbolic.raw() {
         SymbolicCholeskyRaw::Simplicial(f) => {
             let (p, q) = (f.col_ptr()[s], f.col_ptr()[s + 1]);
@@ -46,7 +49,11 @@ pub(crate) fn shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> (usize, usi
     }
 }
 
-pub(crate) fn block<'a>(symbolic: &'a SymbolicCholesky<usize>, values: &'a [f64], s: usize) -> Block<'a> {
+pub(crate) fn block<'a>(
+    symbolic: &'a SymbolicCholesky<usize>,
+    values: &'a [f64],
+    s: usize,
+) -> Block<'a> {
     let (begin, width, pattern, range) = shape(symbolic, s);
     Block {
         begin,
@@ -295,7 +302,10 @@ pub(crate) mod tests {
                 let want = gram_by_solves(&mut s, n, &b);
                 let big = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 for (g, r) in got.iter().zip(&want) {
-                    assert!((g - r).abs() <= 1e-10 * big, "k {k} {ordering:?}: {g} vs {r}");
+                    assert!(
+                        (g - r).abs() <= 1e-10 * big,
+                        "k {k} {ordering:?}: {g} vs {r}"
+                    );
                 }
                 // The empty column reaches nothing; on the large grid with nested dissection a
                 // column reaches a small part of the factor.
@@ -325,7 +335,10 @@ pub(crate) mod tests {
                 s.solve_in_place(&mut two, 2).unwrap();
                 let big = two.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 for (x, y) in one.iter().zip(&two) {
-                    assert!((x - y).abs() <= 1e-12 * big, "k {k} {ordering:?}: {x} vs {y}");
+                    assert!(
+                        (x - y).abs() <= 1e-12 * big,
+                        "k {k} {ordering:?}: {x} vs {y}"
+                    );
                 }
                 let r = fibercell_solver::backward_error(a.as_ref(), &one, &b);
                 assert!(r <= 1e-14, "k {k} {ordering:?}: backward error {r}");
