@@ -100,6 +100,63 @@ fn every_backend_and_ordering_agrees() {
     }
 }
 
+/// The optional half and sparse forward solves: where a backend offers them, Wᵀ W equals
+/// Bᵀ A⁻¹ B from its own full solves and lower-then-upper equals a solve (1e-10 of the scale,
+/// on the frame and grid systems); elsewhere they are `Unavailable`. faer's LLᵀ must offer
+/// them.
+#[test]
+fn half_and_sparse_forward_solves_agree_with_full_solves_or_are_unavailable() {
+    for (name, sys) in systems() {
+        let a = sys.matrix().unwrap();
+        let n = a.ncols();
+        let columns: Vec<Vec<(usize, f64)>> = vec![
+            vec![(0, 1.0), (n / 2, -0.5)],
+            vec![(n - 1, 2.0)],
+            vec![(n / 3, 1.0), (n / 3 + 1, 1.0), (2 * n / 3, -1.0)],
+        ];
+        for (sname, mut s) in direct_solvers() {
+            s.analyze(a).unwrap();
+            s.factorize(a).unwrap();
+            let must = sname.starts_with("faer Llt");
+            let w = match s.forward_solve_sparse(&columns) {
+                Ok(w) => w,
+                Err(SolverError::Unavailable { .. }) if !must => continue,
+                Err(e) => panic!("{sname} on {name}: {e}"),
+            };
+            let k = columns.len();
+            let mut x = vec![0.0; n * k];
+            for (j, col) in columns.iter().enumerate() {
+                col.iter().for_each(|&(i, v)| x[j * n + i] = v);
+            }
+            s.solve_in_place(&mut x, k).unwrap();
+            let gram = w.gram();
+            let scale = gram.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for j in 0..k {
+                for (i, col) in columns.iter().enumerate() {
+                    let want: f64 = col.iter().map(|&(r, v)| v * x[j * n + r]).sum();
+                    let got = gram[j * k + i];
+                    assert!(
+                        (got - want).abs() <= 1e-10 * scale,
+                        "{sname} on {name}: ({i}, {j}) {got} vs {want}"
+                    );
+                }
+            }
+            let mut half = sys.rhs.clone();
+            s.solve_lower_in_place(&mut half).unwrap();
+            s.solve_upper_in_place(&mut half).unwrap();
+            let mut full = sys.rhs.clone();
+            s.solve_in_place(&mut full, 1).unwrap();
+            let scale = full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (p, q) in half.iter().zip(&full) {
+                assert!(
+                    (p - q).abs() <= 1e-10 * scale,
+                    "{sname} on {name}: {p} vs {q}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn every_backend_through_the_mechanics() {
     let m = io::load_model(Path::new("fixtures/ok_frame3d.toml")).unwrap();
