@@ -80,6 +80,30 @@ fn bench_backend(
             s.solve_in_place(black_box(&mut x), 1).expect("solve")
         })
     });
+    // The optional halves (LLᵀ backends): 64 unit columns spread over the matrix by sparse
+    // forward solves, and the forward and backward halves of one solve.
+    let n = a.ncols();
+    let columns: Vec<Vec<(usize, f64)>> = (0..64).map(|j| vec![(j * n / 64, 1.0)]).collect();
+    if s.forward_solve_sparse(&columns).is_ok() {
+        g.bench_function("forward_sparse_64", |b| {
+            b.iter(|| {
+                s.forward_solve_sparse(black_box(&columns))
+                    .expect("forward")
+            })
+        });
+        g.bench_function("solve_lower", |b| {
+            b.iter(|| {
+                x.copy_from_slice(&sys.rhs);
+                s.solve_lower_in_place(black_box(&mut x)).expect("lower")
+            })
+        });
+        g.bench_function("solve_upper", |b| {
+            b.iter(|| {
+                x.copy_from_slice(&sys.rhs);
+                s.solve_upper_in_place(black_box(&mut x)).expect("upper")
+            })
+        });
+    }
     g.finish();
 }
 

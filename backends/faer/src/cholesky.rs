@@ -225,7 +225,7 @@ impl LinearSolver for FaerCholesky {
             fingerprint: a.fingerprint(),
             lower: lower_tri,
             perm,
-            schedule: SolveSchedule::new(&tree, &symbolic, threads(self.par)),
+            schedule: SolveSchedule::new(&tree, threads(self.par)),
             tree,
             factor_inv: match symbolic.perm() {
                 Some(p) => p.arrays().1.to_vec(),
@@ -337,13 +337,15 @@ impl LinearSolver for FaerCholesky {
         if n == 0 {
             return Ok(SolveInfo::default());
         }
-        if nrhs == 1 && self.variant == CholeskyVariant::Llt {
-            // One right-hand side: our block solve (faer's runs at a quarter of the bandwidth).
+        if nrhs == 1 && self.variant == CholeskyVariant::Llt && an.schedule.is_parallel() {
+            // One right-hand side on a factor large enough to split over the threads: our
+            // block solve (faer's runs at a quarter of the bandwidth; on a factor that fits in
+            // cache faer's kernels are faster).
             let mut x = vec![0.0; n];
             for (old, &new) in an.factor_inv.iter().enumerate() {
                 x[new] = rhs[old] * f.scale[old];
             }
-            block_solve(&an.schedule, &an.symbolic, &f.l_values, &mut x);
+            block_solve(&an.tree, &an.schedule, &an.symbolic, &f.l_values, &mut x);
             for (old, &new) in an.factor_inv.iter().enumerate() {
                 rhs[old] = x[new] * f.scale[old];
             }
@@ -397,7 +399,7 @@ impl LinearSolver for FaerCholesky {
         for (old, &new) in an.factor_inv.iter().enumerate() {
             y[new] = x[old] * f.scale[old];
         }
-        forward_in_place(&an.schedule, &an.symbolic, &f.l_values, &mut y);
+        forward_in_place(&an.tree, &an.schedule, &an.symbolic, &f.l_values, &mut y);
         x.copy_from_slice(&y);
         Ok(())
     }
@@ -405,7 +407,7 @@ impl LinearSolver for FaerCholesky {
     fn solve_upper_in_place(&mut self, y: &mut [f64]) -> Result<(), SolverError> {
         let (an, f) = self.llt_parts()?;
         <dyn LinearSolver>::check_rhs(an.n, y, 1)?;
-        backward_in_place(&an.schedule, &an.symbolic, &f.l_values, y);
+        backward_in_place(&an.tree, &an.schedule, &an.symbolic, &f.l_values, y);
         let x: Vec<f64> = an
             .factor_inv
             .iter()
