@@ -20,6 +20,9 @@ pub struct Pattern {
     n_elements: usize,
     block_offsets: Vec<usize>,
     slots: Vec<u32>,
+    /// Whether the CSC pattern passed [`CscRef::check_pattern`] (then [`Pattern::matrix`]
+    /// checks only sizes).
+    checked: bool,
 }
 
 /// The pattern has more entries than the 32-bit slot map can address.
@@ -118,7 +121,9 @@ impl Pattern {
             }
             block_offsets.push(slots.len());
         }
+        let checked = CscRef::check_pattern(n, n, &col_ptr, &row_idx).is_ok();
         Ok(Pattern {
+            checked,
             n,
             col_ptr,
             row_idx,
@@ -161,6 +166,11 @@ impl Pattern {
     }
     /// A matrix view with these values.
     pub fn matrix<'a>(&'a self, values: &'a [f64]) -> Result<CscRef<'a>, SolverError> {
-        CscRef::new(self.n, self.n, &self.col_ptr, &self.row_idx, values)
+        if self.checked {
+            // SAFETY: the pattern passed `check_pattern` at construction and never changes.
+            unsafe { CscRef::new_unchecked(self.n, self.n, &self.col_ptr, &self.row_idx, values) }
+        } else {
+            CscRef::new(self.n, self.n, &self.col_ptr, &self.row_idx, values)
+        }
     }
 }

@@ -839,6 +839,9 @@ pub(crate) fn run_incremental(
     let mut reference_solution: Option<Reference>;
     let mut low_rank = LowRankCorrection::new(n_free, pairs.len());
     let mut reference_values = vec![0.0; pattern.nnz()];
+    // When `values` is `reference_values` plus the blocks of these contacts only: restoring
+    // their slots is enough to start the next iteration from the reference.
+    let mut changed_since_reference: Option<Vec<usize>> = None;
     // Per contact, its block columns on prescribed DOFs (their products go to the load).
     let prescribed: Vec<Vec<usize>> = pairs
         .iter()
@@ -920,7 +923,19 @@ pub(crate) fn run_incremental(
                     .collect()
             });
             if let Some(changes) = &changes {
-                values.copy_from_slice(&reference_values);
+                match changed_since_reference.take() {
+                    Some(contacts) => {
+                        for i in contacts {
+                            for &slot in pattern.extra_slots(i) {
+                                if slot != NO_SLOT {
+                                    values[slot as usize] = reference_values[slot as usize];
+                                }
+                            }
+                        }
+                    }
+                    None => values.copy_from_slice(&reference_values),
+                }
+                changed_since_reference = Some(changes.iter().map(|ch| ch.contact).collect());
                 for ch in changes {
                     add_block_change(
                         &pairs[ch.contact],
@@ -930,6 +945,7 @@ pub(crate) fn run_incremental(
                     );
                 }
             } else {
+                changed_since_reference = None;
                 values.copy_from_slice(&k_elastic);
             }
             let write_values = changes.is_none();
@@ -1144,6 +1160,7 @@ pub(crate) fn run_incremental(
                         );
                         refactorized = true;
                         reference_values.copy_from_slice(&values);
+                        changed_since_reference = Some(Vec::new());
                         low_rank.reset();
                     }
                     lap(&mut timings.factorize, &mut clock);

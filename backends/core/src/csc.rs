@@ -98,6 +98,48 @@ impl<'a> CscRef<'a> {
         })
     }
 
+    /// Checks a pattern (sizes, bounds, sorted unique rows) once, for
+    /// [`CscRef::new_unchecked`] with many value arrays.
+    pub fn check_pattern(
+        nrows: usize,
+        ncols: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+    ) -> Result<(), SolverError> {
+        check_structure(nrows, ncols, col_ptr, row_idx, row_idx.len())
+    }
+
+    /// Wraps the arrays checking only their sizes (O(1)): for a pattern reused with new values
+    /// in a loop.
+    ///
+    /// # Safety
+    ///
+    /// The pattern must have passed [`CscRef::check_pattern`] (or [`CscRef::new`]): backends
+    /// hand the row indices to foreign code (CHOLMOD) that does not check them.
+    pub unsafe fn new_unchecked(
+        nrows: usize,
+        ncols: usize,
+        col_ptr: &'a [usize],
+        row_idx: &'a [usize],
+        values: &'a [f64],
+    ) -> Result<Self, SolverError> {
+        if col_ptr.len() != ncols + 1 || values.len() != row_idx.len() {
+            return Err(SolverError::InvalidMatrix(format!(
+                "{} column pointers and {} values for {ncols} columns and {} entries",
+                col_ptr.len(),
+                values.len(),
+                row_idx.len()
+            )));
+        }
+        Ok(CscRef {
+            nrows,
+            ncols,
+            col_ptr,
+            row_idx,
+            values,
+        })
+    }
+
     /// Borrows an sprs matrix without copying. It must be stored CSC with a plain (unsliced)
     /// index pointer; use [`CscMatrix::from_sprs`] for any other sprs matrix.
     pub fn try_from_sprs(m: &'a CsMatView<'_, f64>) -> Result<Self, SolverError> {
@@ -351,6 +393,19 @@ impl CscMatrix {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A pattern checked once, then wrapped with values checking sizes only.
+    #[test]
+    fn checked_pattern_then_unchecked_views_check_sizes() {
+        assert!(CscRef::check_pattern(2, 2, &[0, 2, 3], &[1, 0, 1]).is_err());
+        assert!(CscRef::check_pattern(2, 2, &[0, 2, 3], &[0, 1, 1]).is_ok());
+        // SAFETY: the pattern was checked just above.
+        let a = unsafe { CscRef::new_unchecked(2, 2, &[0, 2, 3], &[0, 1, 1], &[1.0, 2.0, 3.0]) };
+        assert_eq!(a.map(|a| a.nnz()).ok(), Some(3));
+        // SAFETY: as above.
+        let e = unsafe { CscRef::new_unchecked(2, 2, &[0, 2, 3], &[0, 1, 1], &[1.0]) };
+        assert!(matches!(e, Err(SolverError::InvalidMatrix(_))));
+    }
 
     #[test]
     fn rejects_unsorted_rows_and_bad_pointers() {
