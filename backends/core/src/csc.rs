@@ -89,13 +89,8 @@ impl<'a> CscRef<'a> {
         values: &'a [f64],
     ) -> Result<Self, SolverError> {
         check_structure(nrows, ncols, col_ptr, row_idx, values.len())?;
-        Ok(CscRef {
-            nrows,
-            ncols,
-            col_ptr,
-            row_idx,
-            values,
-        })
+        // SAFETY: the pattern was checked just above.
+        unsafe { Self::new_unchecked(nrows, ncols, col_ptr, row_idx, values) }
     }
 
     /// Checks a pattern (sizes, bounds, sorted unique rows) once, for
