@@ -31,8 +31,8 @@ use crate::contact::{
 use crate::model::Model;
 use crate::Error;
 use fibercell_solver::{
-    backward_from_product, norm_inf, norm_inf_symmetric_par, relative_from_product, solve_checked,
-    CscRef, LinearSolver, SolveInfo, SolveReport, SolverError,
+    backward_from_product, norm_inf, relative_from_product, solve_checked, CscRef, LinearSolver,
+    SolveInfo, SolveReport, SolverError,
 };
 use nalgebra::{DMatrix, DVector, Vector2, Vector3, Vector6};
 use rayon::prelude::*;
@@ -431,17 +431,23 @@ fn refine_low_rank(
     let Ok(mut x) = first else {
         return Ok(None);
     };
-    let norm_a = if symmetric {
-        norm_inf_symmetric_par(a)
-    } else {
-        norm_inf(a)
-    };
     let mut ax = vec![0.0; b.len()];
+    let mut norm_a = None;
     for refinements in 0..=MAX_REFINEMENTS {
-        if symmetric {
-            a.mul_vec_symmetric_par(&x, &mut ax);
-        } else {
-            a.mul_vec(&x, &mut ax);
+        let norm_a = *norm_a.get_or_insert_with(|| {
+            if symmetric {
+                a.mul_vec_symmetric_norm_par(&x, &mut ax)
+            } else {
+                a.mul_vec(&x, &mut ax);
+                norm_inf(a)
+            }
+        });
+        if refinements > 0 {
+            if symmetric {
+                a.mul_vec_symmetric_par(&x, &mut ax);
+            } else {
+                a.mul_vec(&x, &mut ax);
+            }
         }
         let backward_error = backward_from_product(norm_a, &ax, &x, b);
         if !backward_error.is_finite() {
@@ -863,6 +869,8 @@ pub(crate) fn run_incremental(
         let increment_start = std::time::Instant::now();
         // New α and committed slips: a new reference load.
         reference_solution = None;
+        // α F + the loads of all contacts as stuck, for this increment's α and slips.
+        let mut stuck_load: Option<Vec<f64>> = None;
         // Per contact γ = Gᵀ α ū on its prescribed DOFs: its block's products with them are
         // the load −G D γ.
         let prescribed_jump: Vec<Vector6<f64>> = pairs
@@ -899,6 +907,8 @@ pub(crate) fn run_incremental(
             // contacts that changed since (G ΔD Gᵀ), else element and contact blocks anew.
             let changes: Option<Vec<ContactChange>> = reference.as_ref().map(|reference| {
                 (0..pairs.len())
+                    .into_par_iter()
+                    .with_min_len(256)
                     .filter_map(|i| {
                         let current = block_state(&states, &directions, &perpendicular, i);
                         let r = &reference[i];
@@ -978,57 +988,85 @@ pub(crate) fn run_incremental(
                 }
                 (k, f)
             };
-            // The contact blocks for the current states, computed and scattered in parallel
-            // color by color (sums independent of the number of threads).
-            {
-                let shared_values = SharedMut::new(&mut values);
-                let shared_rhs = SharedMut::new(&mut rhs);
-                for color in &contact_colors {
-                    color.par_iter().with_min_len(16).for_each(|&i| {
-                        let pair = &pairs[i];
-                        let m = pair.size();
-                        let slots = pattern.extra_slots(i);
-                        let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
-                        let scatter = |k: &dyn Fn(usize, usize) -> f64, f: &BlockVector| {
-                            for r in 0..m {
-                                let Some(ir) = disc.reduced(gdof(r)) else {
-                                    continue;
-                                };
-                                // SAFETY: row r is a free DOF of a node no other contact of
-                                // this color holds, and so are the slots of row r.
-                                let rhs_r = unsafe { shared_rhs.get(ir) };
-                                *rhs_r += f[r];
-                                if write_values {
-                                    for c in 0..m {
-                                        let s = slots[r * m + c];
-                                        if s != NO_SLOT {
-                                            // SAFETY: as above.
-                                            unsafe { *shared_values.get(s as usize) += k(r, c) };
-                                        }
-                                    }
-                                }
-                                for &c in &prescribed[i] {
-                                    *rhs_r -= k(r, c) * alpha * disc.prescribed_value(gdof(c));
-                                }
-                            }
+            // Contact i's load in `state`, times `sign`, into `rhs`, and with `values` its
+            // block into the matrix: the caller keeps concurrent calls on distinct nodes.
+            let contact_into = |i: usize,
+                                state: ContactState,
+                                sign: f64,
+                                rhs: &SharedMut<f64>,
+                                values: Option<&SharedMut<f64>>| {
+                let pair = &pairs[i];
+                let m = pair.size();
+                let slots = pattern.extra_slots(i);
+                let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
+                let scatter = |k: &dyn Fn(usize, usize) -> f64, f: &BlockVector| {
+                    for r in 0..m {
+                        let Some(ir) = disc.reduced(gdof(r)) else {
+                            continue;
                         };
-                        match states[i] {
-                            // Stuck contacts, the most, entry by entry: K_N + K_T^st + K_R.
-                            ContactState::Stick => {
-                                scatter(&pair.closed_stiffness(true), &pair.stick_load(&slips[i]))
-                            }
-                            // ε (K_N + K_T^st + K_R), the open contact's stabilizer.
-                            ContactState::Open if stabilization > 0.0 => {
-                                let k = pair.closed_stiffness(true);
-                                scatter(&|r, c| stabilization * k(r, c), &BlockVector::zeros())
-                            }
-                            ContactState::Open => {}
-                            ContactState::Slip => {
-                                let (k, f) = sliding_block(i);
-                                scatter(&|r, c| k[(r, c)], &f)
+                        // SAFETY: row r is a free DOF of a node no concurrent call holds, and
+                        // so are the slots of row r.
+                        let rhs_r = unsafe { rhs.get(ir) };
+                        *rhs_r += sign * f[r];
+                        if let Some(values) = values {
+                            for c in 0..m {
+                                let s = slots[r * m + c];
+                                if s != NO_SLOT {
+                                    // SAFETY: as above.
+                                    unsafe { *values.get(s as usize) += k(r, c) };
+                                }
                             }
                         }
+                        for &c in &prescribed[i] {
+                            *rhs_r -= sign * k(r, c) * alpha * disc.prescribed_value(gdof(c));
+                        }
+                    }
+                };
+                match state {
+                    // Stuck contacts, the most, entry by entry: K_N + K_T^st + K_R.
+                    ContactState::Stick => {
+                        scatter(&pair.closed_stiffness(true), &pair.stick_load(&slips[i]))
+                    }
+                    // ε (K_N + K_T^st + K_R), the open contact's stabilizer.
+                    ContactState::Open if stabilization > 0.0 => {
+                        let k = pair.closed_stiffness(true);
+                        scatter(&|r, c| stabilization * k(r, c), &BlockVector::zeros())
+                    }
+                    ContactState::Open => {}
+                    ContactState::Slip => {
+                        let (k, f) = sliding_block(i);
+                        scatter(&|r, c| k[(r, c)], &f)
+                    }
+                }
+            };
+            // Color by color in parallel (sums independent of the number of threads).
+            let by_colors = |state: &(dyn Fn(usize) -> ContactState + Sync),
+                             rhs: &mut [f64],
+                             values: Option<&mut [f64]>| {
+                let shared_rhs = SharedMut::new(rhs);
+                let shared_values = values.map(SharedMut::new);
+                for color in &contact_colors {
+                    color.par_iter().with_min_len(16).for_each(|&i| {
+                        contact_into(i, state(i), 1.0, &shared_rhs, shared_values.as_ref())
                     });
+                }
+            };
+            if write_values {
+                // The contact blocks and loads for the current states.
+                by_colors(&|i| states[i], &mut rhs, Some(&mut values));
+            } else {
+                // Only the load: every contact stuck once per increment (α and the slips are
+                // fixed within it), then the contacts in another state swapped in.
+                let stuck = stuck_load.get_or_insert_with(|| {
+                    let mut stuck = rhs.clone();
+                    by_colors(&|_| ContactState::Stick, &mut stuck, None);
+                    stuck
+                });
+                rhs.copy_from_slice(stuck);
+                let shared_rhs = SharedMut::new(&mut rhs);
+                for i in (0..pairs.len()).filter(|&i| states[i] != ContactState::Stick) {
+                    contact_into(i, ContactState::Stick, -1.0, &shared_rhs, None);
+                    contact_into(i, states[i], 1.0, &shared_rhs, None);
                 }
             }
             if disc.is_identity() {

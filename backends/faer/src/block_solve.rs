@@ -8,13 +8,22 @@
 //! backward, the top blocks first, then the subtrees in parallel (they only read the top rows).
 
 use crate::sparse_forward::{Block, BlockTree, NONE};
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
+use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
 /// Subtrees are split until the largest holds at most this share above an even one.
 const BALANCE: f64 = 1.05;
 /// At most this many blocks move to the top while balancing.
 const MAX_SPLITS: usize = 512;
+/// Blocks with at least this many values use faer's dense kernels (runtime-dispatched SIMD);
+/// smaller ones the plain loops, whose call overhead is lower.
+const DENSE_KERNEL_VALUES: usize = 1 << 10;
 /// Factors with fewer values are solved on one thread.
 const PARALLEL_VALUES: usize = 1 << 20;
 
@@ -152,6 +161,21 @@ fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>) {
     let ld = b.width + b.pattern.len();
     below.clear();
     below.resize(b.pattern.len(), 0.0);
+    if b.values.len() >= DENSE_KERNEL_VALUES {
+        let (l_top, l_bottom) =
+            MatRef::from_column_major_slice(b.values, ld, b.width).split_at_row(b.width);
+        let mut x = MatMut::from_column_major_slice_mut(top, b.width, 1);
+        solve_lower_triangular_in_place(l_top, x.rb_mut(), Par::Seq);
+        matmul(
+            MatMut::from_column_major_slice_mut(below, b.pattern.len(), 1),
+            Accum::Replace,
+            l_bottom,
+            x.rb(),
+            1.0,
+            Par::Seq,
+        );
+        return;
+    }
     for c in 0..b.width {
         let col = &b.values[c * ld..(c + 1) * ld];
         let xc = top[c] / col[c];
@@ -169,6 +193,21 @@ fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>) {
 /// pattern rows.
 fn backward_block(b: &Block<'_>, top: &mut [f64], below: &[f64]) {
     let ld = b.width + b.pattern.len();
+    if b.values.len() >= DENSE_KERNEL_VALUES {
+        let (l_top, l_bottom) =
+            MatRef::from_column_major_slice(b.values, ld, b.width).split_at_row(b.width);
+        let mut x = MatMut::from_column_major_slice_mut(top, b.width, 1);
+        matmul(
+            x.rb_mut(),
+            Accum::Add,
+            l_bottom.transpose(),
+            MatRef::from_column_major_slice(below, b.pattern.len(), 1),
+            -1.0,
+            Par::Seq,
+        );
+        solve_upper_triangular_in_place(l_top.transpose(), x, Par::Seq);
+        return;
+    }
     for c in (0..b.width).rev() {
         let col = &b.values[c * ld..(c + 1) * ld];
         let sum = dot(&col[c + 1..b.width], &top[c + 1..]) + dot(&col[b.width..], below);
