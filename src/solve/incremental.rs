@@ -37,6 +37,7 @@ use fibercell_solver::{
 use nalgebra::{DMatrix, DVector, Vector2, Vector3, Vector6};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::OnceLock;
 
 /// A callback told after every increment: (increments done, increments in all).
 #[derive(Clone)]
@@ -544,7 +545,13 @@ struct Elastic {
     maps: Vec<Option<(Vec<usize>, DMatrix<f64>)>>,
     /// The discretization is the identity (a supported structure).
     identity: bool,
+    /// Every element's Tᵀ K T, kept after first use when they take at most
+    /// [`ELEMENT_CACHE_BYTES`] (the internal forces of every increment's commit need them).
+    cache: OnceLock<Option<Vec<DMatrix<f64>>>>,
 }
+
+/// Largest memory the element matrices of the commit are kept in.
+const ELEMENT_CACHE_BYTES: usize = 512 << 20;
 
 impl Elastic {
     fn new(model: &Model, disc: &Discretization) -> Self {
@@ -562,6 +569,36 @@ impl Elastic {
                 })
                 .collect(),
             identity,
+            cache: OnceLock::new(),
+        }
+    }
+
+    /// Every element's Tᵀ K T when they fit in [`ELEMENT_CACHE_BYTES`].
+    fn cached(&self, model: &Model) -> Option<&[DMatrix<f64>]> {
+        self.cache
+            .get_or_init(|| {
+                let bytes: usize = (0..self.maps.len())
+                    .map(|e| 8 * (6 * self.block_nodes(model, e)).pow(2))
+                    .sum();
+                (bytes <= ELEMENT_CACHE_BYTES)
+                    .then(|| self.matrices(model).map(|(_, k)| k).collect())
+            })
+            .as_deref()
+    }
+
+    /// `f(e, Tᵀ K T)` for every element in order, from the cache when it fits.
+    fn for_each_matrix(&self, model: &Model, mut f: impl FnMut(usize, &DMatrix<f64>)) {
+        match self.cached(model) {
+            Some(all) => all.iter().enumerate().for_each(|(e, k)| f(e, k)),
+            None => self.matrices(model).for_each(|(e, k)| f(e, &k)),
+        }
+    }
+
+    /// Nodes of element e's block.
+    fn block_nodes(&self, model: &Model, e: usize) -> usize {
+        match &self.maps[e] {
+            Some((g, _)) => g.len(),
+            None => model.elements()[e].nodes.len(),
         }
     }
 
@@ -610,7 +647,7 @@ impl Elastic {
             return Ok(());
         }
         values.iter_mut().for_each(|v| *v = 0.0);
-        for (e, k) in self.matrices(model) {
+        self.for_each_matrix(model, |e, k| {
             let m = k.nrows();
             let slots = pattern.element_slots(e);
             for r in 0..m {
@@ -621,7 +658,7 @@ impl Elastic {
                     }
                 }
             }
-        }
+        });
         Ok(())
     }
 
@@ -668,14 +705,14 @@ impl Elastic {
             return internal_forces(model, &q[..6 * model.nodes.len()]);
         }
         let mut out = vec![0.0; q.len()];
-        for (e, k) in self.matrices(model) {
+        self.for_each_matrix(model, |e, k| {
             let gnodes = self.gnodes(model, e);
             let qe = DVector::from_fn(6 * gnodes.len(), |c, _| q[6 * gnodes[c / 6] + c % 6]);
             let f = k * qe;
             for (r, v) in f.iter().enumerate() {
                 out[6 * gnodes[r / 6] + r % 6] += v;
             }
-        }
+        });
         out
     }
 }
