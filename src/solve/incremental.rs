@@ -1101,9 +1101,34 @@ pub(crate) fn run_incremental(
                 });
                 rhs.copy_from_slice(stuck);
                 let shared_rhs = SharedMut::new(&mut rhs);
+                let stick = BlockState {
+                    state: ContactState::Stick,
+                    direction: Vector2::zeros(),
+                    k_perp: 0.0,
+                };
                 for i in (0..pairs.len()).filter(|&i| states[i] != ContactState::Stick) {
-                    contact_into(i, ContactState::Stick, -1.0, &shared_rhs, None);
-                    contact_into(i, states[i], 1.0, &shared_rhs, None);
+                    if !prescribed[i].is_empty() {
+                        contact_into(i, ContactState::Stick, -1.0, &shared_rhs, None);
+                        contact_into(i, states[i], 1.0, &shared_rhs, None);
+                        continue;
+                    }
+                    // No prescribed DOFs: the load alone, G (φ − φ_stick) (see
+                    // ContactPair::load_coefficients), without the block.
+                    let pair = &pairs[i];
+                    let (anchor, slip) = (&perpendicular[i].1, &slips[i]);
+                    let current = block_state(&states, &directions, &perpendicular, i);
+                    let phi = pair.load_coefficients(&current, anchor, slip, friction)
+                        - pair.load_coefficients(&stick, anchor, slip, friction);
+                    let g = pair.jump_basis();
+                    for r in 0..pair.size() {
+                        let gdof = 6 * pair.jump.nodes[r / 6] + r % 6;
+                        if let Some(ir) = disc.reduced(gdof) {
+                            // SAFETY: one contact at a time.
+                            unsafe {
+                                *shared_rhs.get(ir) += (0..6).map(|a| phi[a] * g[a][r]).sum::<f64>()
+                            };
+                        }
+                    }
                 }
             }
             if disc.is_identity() {

@@ -189,21 +189,24 @@ impl LinearSolver for FaerCholesky {
         );
         let (perm, symbolic, name) = match &self.ordering {
             Ordering::Auto => {
-                // Both candidates, keep the one with fewer predicted flops.
-                let mut best: Option<(Permutation, SymbolicCholesky<usize>, f64, &str)> = None;
-                for (o, nm) in [
-                    (Ordering::Amd, "auto→amd"),
-                    (Ordering::NestedDissection, "auto→nested-dissection"),
-                ] {
+                // Both candidates side by side (METIS and AMD are sequential), keep the one
+                // with fewer predicted flops (AMD on a tie).
+                let candidate = |o: Ordering| -> Result<_, SolverError> {
                     let p = compute_ordering(a, &o)?;
                     let s = self.symbolic_for(lower, &p)?;
                     let flops = fill_and_flops(&s).1;
-                    if best.as_ref().is_none_or(|b| flops < b.2) {
-                        best = Some((p, s, flops, nm));
-                    }
+                    Ok((p, s, flops))
+                };
+                let (amd, nd) = rayon::join(
+                    || candidate(Ordering::Amd),
+                    || candidate(Ordering::NestedDissection),
+                );
+                let (amd, nd) = (amd?, nd?);
+                if nd.2 < amd.2 {
+                    (nd.0, nd.1, "auto→nested-dissection".to_string())
+                } else {
+                    (amd.0, amd.1, "auto→amd".to_string())
                 }
-                let (p, s, _, nm) = best.ok_or(SolverError::OutOfMemory)?;
-                (p, s, nm.to_string())
             }
             o => {
                 let p = compute_ordering(a, o)?;
