@@ -1119,14 +1119,15 @@ pub(crate) fn run_incremental(
                     let current = block_state(&states, &directions, &perpendicular, i);
                     let phi = pair.load_coefficients(&current, anchor, slip, friction)
                         - pair.load_coefficients(&stick, anchor, slip, friction);
-                    let g = pair.jump_basis();
-                    for r in 0..pair.size() {
+                    let mut f = BlockVector::zeros();
+                    for (ga, pa) in pair.jump_basis().iter().zip(phi.iter()) {
+                        f += ga * *pa;
+                    }
+                    for (r, fr) in f.iter().enumerate().take(pair.size()) {
                         let gdof = 6 * pair.jump.nodes[r / 6] + r % 6;
                         if let Some(ir) = disc.reduced(gdof) {
                             // SAFETY: one contact at a time.
-                            unsafe {
-                                *shared_rhs.get(ir) += (0..6).map(|a| phi[a] * g[a][r]).sum::<f64>()
-                            };
+                            unsafe { *shared_rhs.get(ir) += fr };
                         }
                     }
                 }
