@@ -74,28 +74,30 @@ impl SolveSchedule {
                 top_rows: 0,
             };
         }
+        // Split the largest subtree until the longest-processing-time-first assignment of the
+        // pool is balanced (its largest load within BALANCE of an even share).
         for _ in 0..MAX_SPLITS {
             let pooled: usize = pool.iter().map(|&s| weight[s]).sum();
+            let assigned = assign_longest_first(&mut pool, &weight, threads);
+            if assigned.1.iter().copied().max().unwrap_or(0) as f64
+                <= BALANCE * pooled as f64 / threads as f64
+            {
+                break;
+            }
             let Some(at) = (0..pool.len()).max_by_key(|&k| weight[pool[k]]) else {
                 break;
             };
             let largest = pool[at];
-            if weight[largest] as f64 <= BALANCE * pooled as f64 / threads as f64
-                || children[largest].is_empty()
-            {
+            if children[largest].is_empty() {
                 break;
             }
             pool.swap_remove(at);
             top.push(largest);
             pool.extend(&children[largest]);
         }
-        // Longest processing time first.
-        pool.sort_by_key(|&s| std::cmp::Reverse(weight[s]));
+        let (owner, _) = assign_longest_first(&mut pool, &weight, threads);
         let mut tasks: Vec<Vec<usize>> = vec![Vec::new(); threads];
-        let mut load = vec![0usize; threads];
-        for root in pool {
-            let t = (0..threads).min_by_key(|&t| load[t]).unwrap_or(0);
-            load[t] += weight[root];
+        for (&root, &t) in pool.iter().zip(&owner) {
             let mut stack = vec![root];
             while let Some(s) = stack.pop() {
                 tasks[t].push(s);
@@ -121,6 +123,26 @@ impl SolveSchedule {
             top_rows,
         }
     }
+}
+
+/// Sorts `pool` by decreasing weight and gives each subtree to the least loaded of `threads`
+/// (longest processing time first): the thread of each pool entry and the loads.
+fn assign_longest_first(
+    pool: &mut [usize],
+    weight: &[usize],
+    threads: usize,
+) -> (Vec<usize>, Vec<usize>) {
+    pool.sort_by_key(|&s| std::cmp::Reverse(weight[s]));
+    let mut load = vec![0usize; threads];
+    let owner = pool
+        .iter()
+        .map(|&root| {
+            let t = (0..threads).min_by_key(|&t| load[t]).unwrap_or(0);
+            load[t] += weight[root];
+            t
+        })
+        .collect();
+    (owner, load)
 }
 
 /// The solution vector shared by the threads, each writing its own rows only.
@@ -339,6 +361,15 @@ mod tests {
             if threads > 1 {
                 assert_eq!(schedule.tasks.len(), threads);
                 assert!(!schedule.top.is_empty());
+                // The tasks' factor values are balanced to BALANCE of an even share.
+                let loads: Vec<usize> = schedule
+                    .tasks
+                    .iter()
+                    .map(|t| t.iter().map(|&s| tree.shapes[s].values.len()).sum())
+                    .collect();
+                let even = loads.iter().sum::<usize>() as f64 / threads as f64;
+                let most = loads.iter().copied().max().unwrap_or(0) as f64;
+                assert!(most <= BALANCE * even, "{threads} threads: loads {loads:?}");
             }
             let mut x = vec![0.0; n];
             for (old, &new) in inv.iter().enumerate() {
