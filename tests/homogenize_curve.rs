@@ -131,6 +131,14 @@ fn all_stick_curve_is_the_elastic_homogenization() {
     assert_eq!(h.contacts, 1);
     let c = curve(&d, 4, false);
     assert!(c.switches.is_empty());
+    // The curve's own ABD (six cell problems without Θ) is homogenize_elastic's: same matrix,
+    // same solves, up to rounding.
+    let scale = h.abd.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (row, want) in c.elastic_abd.iter().zip(&h.abd) {
+        for (v, w) in row.iter().zip(want) {
+            assert!((v - w).abs() <= 1e-12 * scale, "{v} vs {w}");
+        }
+    }
     for p in &c.points {
         assert_eq!(p.stick, 1);
         for i in 0..6 {

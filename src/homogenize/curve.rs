@@ -3,7 +3,7 @@
 //! strain, the strain at which each contact switches, the piecewise-linear segments (one per
 //! switch), the elastic/plastic split (5.5–5.6) and the dissipated energy.
 
-use super::homogenize_elastic;
+use super::elastic_abd;
 use super::segments::{linear_pieces, segment_starting_at, Segment};
 use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
@@ -96,7 +96,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             "the number of increments must be at least 1".into(),
         ));
     }
-    let elastic = homogenize_elastic(model, &opts.incremental.solve)?;
+    let elastic_abd = elastic_abd(model, &opts.incremental.solve)?;
     let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, false)?;
     let disc = Discretization::periodic(model, &p, &opts.strain, anchor);
     let n = opts.steps;
@@ -117,7 +117,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
         let strain = opts.strain.map(|e| r.alpha * e);
         let resultant = r.macro_reaction.unwrap_or([0.0; 6]).map(|v| v / area);
         let el: [f64; 6] =
-            std::array::from_fn(|i| (0..6).map(|j| elastic.abd[i][j] * strain[j]).sum());
+            std::array::from_fn(|i| (0..6).map(|j| elastic_abd[i][j] * strain[j]).sum());
         points.push(CurvePoint {
             step: r.step,
             alpha: r.alpha,
@@ -174,7 +174,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
         }
     }
     Ok(Curve {
-        elastic_abd: elastic.abd,
+        elastic_abd,
         points,
         switches,
         segments,

@@ -5,12 +5,12 @@
 //! unit area are B^hom (5.4).
 
 use super::pressure::{default_pixel, pressure_load};
-use super::{Orthotropic, PeriodicSystem, ThesisModuli};
+use super::{Orthotropic, PeriodicSystem, PeriodicValues, ThesisModuli};
 use crate::cell::{macro_matrix, CellGeometry};
 use crate::model::Model;
-use crate::solve::{check_backward_error, locate, make_solver, SolveOptions};
+use crate::solve::{check_backward_error, make_solver, SolveOptions};
 use crate::Error;
-use fibercell_solver::{solve_checked, SolverError};
+use fibercell_solver::{solve_checked, LinearSolver, SolverError};
 use nalgebra::DMatrix;
 use serde::Serialize;
 
@@ -109,41 +109,93 @@ pub struct PressureResponse {
     pub displacements: Vec<[f64; 6]>,
 }
 
-/// Solves the six unit cell problems of `model` (which needs a `[cell]`) and returns ABD and
-/// the derived constants.
-pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homogenized, Error> {
-    let start = std::time::Instant::now();
-    let mut clock = start;
+/// The cell matrix of `model` with all closed contacts stuck, assembled, analysed and
+/// factorized: the system, its values and the factorization (stages timed into `timings`).
+fn factor_cell(
+    model: &Model,
+    options: &SolveOptions,
+    timings: &mut HomogenizeTimings,
+) -> Result<(PeriodicSystem, PeriodicValues, Box<dyn LinearSolver>), Error> {
+    let mut clock = std::time::Instant::now();
     let mut lap = || {
         let now = std::time::Instant::now();
         let t = (now - clock).as_secs_f64();
         clock = now;
         t
     };
-    let mut timings = HomogenizeTimings::default();
     let sys = PeriodicSystem::new(model)?;
     timings.setup = lap();
     let vals = sys.assemble(model);
-    let n = sys.n_free();
     let a = sys.pattern.matrix(&vals.values)?;
     timings.assembly = lap();
     let mut solver = make_solver(options.solver, &options.ordering, Vec::new())?;
-    let node_dof = |c: usize| (c < n).then(|| sys.node_dof(c));
-    let locate = |e: SolverError| locate(e, model, &node_dof);
-    solver.analyze(a).map_err(locate)?;
+    solver.analyze(a).map_err(|e| sys.locate(model, e))?;
     timings.analysis = lap();
-    solver.factorize(a).map_err(locate)?;
+    solver.factorize(a).map_err(|e| sys.locate(model, e))?;
     timings.factorization = lap();
-    let g = sys.periodicity.geometry;
-    let area = g.area();
-    let disc = &sys.discretization;
-    let driver = disc.driver().unwrap_or(usize::MAX);
-    let mut rhs = vec![0.0; 7 * n];
+    Ok((sys, vals, solver))
+}
+
+/// ABD = (K_EE + K_Ef x) / |Y| from the driver couplings and the six cell-problem solutions
+/// x = −K_ff⁻¹ K_fE (columns of length `n`, stacked).
+fn abd_of(vals: &PeriodicValues, x: &[f64], n: usize, area: f64) -> [[f64; 6]; 6] {
+    let mut abd = [[0.0; 6]; 6];
+    for (j, row) in abd.iter_mut().enumerate() {
+        for (k, v) in row.iter_mut().enumerate() {
+            let schur: f64 = (0..n).map(|i| vals.coupling[i][j] * x[k * n + i]).sum();
+            *v = (vals.k_ee[(j, k)] + schur) / area;
+        }
+    }
+    abd
+}
+
+/// The right-hand sides −K_fE e_k of the six cell problems, stacked, with room for `extra`
+/// more columns (zero).
+fn cell_rhs(vals: &PeriodicValues, n: usize, extra: usize) -> Vec<f64> {
+    let mut rhs = vec![0.0; (6 + extra) * n];
     for (i, c) in vals.coupling.iter().enumerate() {
         for k in 0..6 {
             rhs[k * n + i] = -c[k];
         }
     }
+    rhs
+}
+
+/// The all-stick ABD of `model` alone: the six cell problems of [`homogenize_elastic`]
+/// without the pressure problem Θ, the moduli and the expanded solutions (what
+/// [`super::elasto_plastic_curve`] splits its resultants with).
+pub fn elastic_abd(model: &Model, options: &SolveOptions) -> Result<[[f64; 6]; 6], Error> {
+    let (sys, vals, mut solver) = factor_cell(model, options, &mut HomogenizeTimings::default())?;
+    let n = sys.n_free();
+    let a = sys.pattern.matrix(&vals.values)?;
+    let rhs = cell_rhs(&vals, n, 0);
+    let (x, report) =
+        solve_checked(solver.as_mut(), a, &rhs, 6).map_err(|e| sys.locate(model, e))?;
+    check_backward_error(options, report.backward_error, "cell problems")?;
+    Ok(abd_of(&vals, &x, n, sys.periodicity.geometry.area()))
+}
+
+/// Solves the six unit cell problems of `model` (which needs a `[cell]`) and returns ABD and
+/// the derived constants.
+pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homogenized, Error> {
+    let start = std::time::Instant::now();
+    let mut timings = HomogenizeTimings::default();
+    let (sys, vals, mut solver) = factor_cell(model, options, &mut timings)?;
+    let mut clock = std::time::Instant::now();
+    let mut lap = || {
+        let now = std::time::Instant::now();
+        let t = (now - clock).as_secs_f64();
+        clock = now;
+        t
+    };
+    let n = sys.n_free();
+    let a = sys.pattern.matrix(&vals.values)?;
+    let locate = |e: SolverError| sys.locate(model, e);
+    let g = sys.periodicity.geometry;
+    let area = g.area();
+    let disc = &sys.discretization;
+    let driver = disc.driver().unwrap_or(usize::MAX);
+    let mut rhs = cell_rhs(&vals, n, 1);
     // The Θ load, moved onto the generalized DOFs (Tᵀ f, periodic images included), and its
     // virial Σ M(x)ᵀ f over the loaded points (images at their shifted positions).
     let load = pressure_load(model, &g, 1.0, default_pixel(model));
@@ -190,13 +242,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
         pixel: load.pixel,
         displacements: sys.expand(theta, &[0.0; 6]),
     };
-    let mut abd = [[0.0; 6]; 6];
-    for (j, row) in abd.iter_mut().enumerate() {
-        for (k, v) in row.iter_mut().enumerate() {
-            let schur: f64 = (0..n).map(|i| vals.coupling[i][j] * x[k * n + i]).sum();
-            *v = (vals.k_ee[(j, k)] + schur) / area;
-        }
-    }
+    let abd = abd_of(&vals, &x, n, area);
     let scale = abd.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     let asym = (0..6)
         .flat_map(|j| (0..6).map(move |k| (j, k)))

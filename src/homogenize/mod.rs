@@ -11,7 +11,9 @@ mod segments;
 pub(crate) mod system;
 
 pub use curve::{elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEvent};
-pub use elastic::{homogenize_elastic, HomogenizeTimings, Homogenized, PressureResponse};
+pub use elastic::{
+    elastic_abd, homogenize_elastic, HomogenizeTimings, Homogenized, PressureResponse,
+};
 pub use orthotropic::{Orthotropic, ThesisModuli};
 pub use pressure::{default_pixel, pressure_load, PressureLoad};
 pub use segments::{segment_starting_at, Segment};

@@ -12,7 +12,7 @@ use crate::constraints::Discretization;
 use crate::contact::{ContactPair, ContactSet, ContactSide};
 use crate::model::{Dof, Model};
 use crate::Error;
-use fibercell_solver::CscMatrix;
+use fibercell_solver::{CscMatrix, SolverError};
 use nalgebra::{DMatrix, SMatrix};
 use rayon::prelude::*;
 
@@ -245,6 +245,13 @@ impl PeriodicSystem {
     /// (node, DOF) of a free unknown.
     pub fn node_dof(&self, k: usize) -> (usize, Dof) {
         self.discretization.node_dof(k)
+    }
+
+    /// A solver error with its column mapped to node, DOF and fibers of `model` where it
+    /// names one.
+    pub(crate) fn locate(&self, model: &Model, e: SolverError) -> Error {
+        let n = self.n_free();
+        crate::solve::locate(e, model, &|c: usize| (c < n).then(|| self.node_dof(c)))
     }
 
     /// Number of closed contacts included as stick springs.
