@@ -436,6 +436,19 @@ struct LowRankSolve {
     refinements: usize,
 }
 
+/// The solve report of a checked low-rank solution.
+fn low_rank_report(r: &LowRankSolve) -> SolveReport {
+    SolveReport {
+        backend: "low-rank",
+        relative_residual: r.relative_residual,
+        backward_error: r.backward_error,
+        info: SolveInfo {
+            iterations: Some(r.refinements),
+            ..SolveInfo::default()
+        },
+    }
+}
+
 /// Corrects `first`, a solution of A x = b by the low-rank correction `cap` of the reference
 /// factorization `a0`, with the residual of the assembled `a` until the backward error is at
 /// most `tolerance`; `None` when [`MAX_REFINEMENTS`] steps do not get there (or the
@@ -966,8 +979,9 @@ pub(crate) fn run_incremental(
         let increment_start = std::time::Instant::now();
         // New α and committed slips: a new reference load.
         reference_solution = None;
-        // α F + the loads of all contacts as stuck, for this increment's α and slips.
-        let mut stuck_load: Option<Vec<f64>> = None;
+        // The contacts' states in it (open as open, all others as stuck) at the first
+        // load-only assembly of this increment, and α F + their loads.
+        let mut base_load: Option<(Vec<ContactState>, Vec<f64>)> = None;
         // Per contact γ = Gᵀ α ū on its prescribed DOFs: its block's products with them are
         // the load −G D γ.
         let prescribed_jump: Vec<Vector6<f64>> = pairs
@@ -1152,33 +1166,41 @@ pub(crate) fn run_incremental(
                 // The contact blocks and loads for the current states.
                 by_colors(&|i| states[i], &mut rhs, Some(&mut values));
             } else {
-                // Only the load: every contact stuck once per increment (α and the slips are
-                // fixed within it), then the contacts in another state swapped in.
-                let stuck = stuck_load.get_or_insert_with(|| {
-                    let mut stuck = rhs.clone();
-                    by_colors(&|_| ContactState::Stick, &mut stuck, None);
-                    stuck
+                // Only the load: once per increment every contact stuck, or open if it is open
+                // now (α and the slips are fixed within it), then the contacts in another state
+                // swapped in.
+                let (base_states, base) = base_load.get_or_insert_with(|| {
+                    let states: Vec<ContactState> = states
+                        .iter()
+                        .map(|&s| match s {
+                            ContactState::Open => ContactState::Open,
+                            _ => ContactState::Stick,
+                        })
+                        .collect();
+                    let mut base = rhs.clone();
+                    by_colors(&|i| states[i], &mut base, None);
+                    (states, base)
                 });
-                rhs.copy_from_slice(stuck);
+                rhs.copy_from_slice(base);
                 let shared_rhs = SharedMut::new(&mut rhs);
-                let stick = BlockState {
-                    state: ContactState::Stick,
-                    direction: Vector2::zeros(),
-                    k_perp: 0.0,
-                };
-                for i in (0..pairs.len()).filter(|&i| states[i] != ContactState::Stick) {
+                for i in (0..pairs.len()).filter(|&i| states[i] != base_states[i]) {
                     if !prescribed[i].is_empty() {
-                        contact_into(i, ContactState::Stick, -1.0, &shared_rhs, None);
+                        contact_into(i, base_states[i], -1.0, &shared_rhs, None);
                         contact_into(i, states[i], 1.0, &shared_rhs, None);
                         continue;
                     }
-                    // No prescribed DOFs: the load alone, G (φ − φ_stick) (see
+                    let base_state = BlockState {
+                        state: base_states[i],
+                        direction: Vector2::zeros(),
+                        k_perp: 0.0,
+                    };
+                    // No prescribed DOFs: the load alone, G (φ − φ_base) (see
                     // ContactPair::load_coefficients), without the block.
                     let pair = &pairs[i];
                     let (anchor, slip) = (&perpendicular[i].1, &slips[i]);
                     let current = block_state(&states, &directions, &perpendicular, i);
                     let phi = pair.load_coefficients(&current, anchor, slip, friction)
-                        - pair.load_coefficients(&stick, anchor, slip, friction);
+                        - pair.load_coefficients(&base_state, anchor, slip, friction);
                     let mut f = BlockVector::zeros();
                     for (ga, pa) in pair.jump_basis().iter().zip(phi.iter()) {
                         f += ga * *pa;
@@ -1200,6 +1222,12 @@ pub(crate) fn run_incremental(
             // After the first factorization, solve on it with the changed contacts as a low-rank
             // correction while that is cheaper than refactorizing (see LowRankCost).
             let mut reused = None;
+            // A low-rank solution not yet checked against the assembled matrix, with its
+            // capacitance: the residual check and correction wait until the contact states are
+            // consistent with it (the states in between only steer the iteration, and the
+            // converged solution is checked as every other).
+            let mut unchecked: Option<Capacitance> = None;
+            let tol = REUSE_ACCURACY * backward_tolerance(&opts.solve);
             if let (Some(changes), Some(a0), true) = (
                 changes.as_ref(),
                 backends.reference.as_mut(),
@@ -1221,7 +1249,6 @@ pub(crate) fn run_incremental(
                             / started.elapsed().as_secs_f64().max(1e-9))
                         .max(1e8);
                     }
-                    let tol = REUSE_ACCURACY * backward_tolerance(&opts.solve);
                     let load = low_rank.active_load(changes);
                     let x0 = match reference_solution.take() {
                         Some(x0) => x0,
@@ -1234,34 +1261,44 @@ pub(crate) fn run_incremental(
                     };
                     let first = low_rank.solve_from(a0.as_mut(), &cap, &x0, &load);
                     reference_solution = Some(x0);
-                    reused = refine_low_rank(
-                        &low_rank,
-                        a0.as_mut(),
-                        &cap,
-                        a,
-                        !nonsymmetric,
-                        &rhs,
-                        tol,
-                        first,
-                    )
-                    .map_err(locate)?;
+                    match first {
+                        // Checked once its states are consistent (see `unchecked`); not in
+                        // the last iteration allowed, which has no next one to fall back to.
+                        Ok(x)
+                            if iteration < opts.max_state_iterations
+                                && x.iter().all(|v| v.is_finite()) =>
+                        {
+                            reused = Some(LowRankSolve {
+                                x,
+                                backward_error: f64::NAN,
+                                relative_residual: f64::NAN,
+                                refinements: 0,
+                            });
+                            unchecked = Some(cap);
+                        }
+                        first => {
+                            reused = refine_low_rank(
+                                &low_rank,
+                                a0.as_mut(),
+                                &cap,
+                                a,
+                                !nonsymmetric,
+                                &rhs,
+                                tol,
+                                first,
+                            )
+                            .map_err(locate)?;
+                        }
+                    }
                     refresh_reference = reused.is_none();
                     lap(&mut timings.factor_reuse, &mut clock);
                 }
             }
-            let (x, report) = if let Some(r) = reused {
+            let (x, mut report) = if let Some(r) = reused {
                 factor_reuses += 1;
                 reuse_iterations_done += r.refinements;
-                let report = SolveReport {
-                    backend: "low-rank",
-                    relative_residual: r.relative_residual,
-                    backward_error: r.backward_error,
-                    info: SolveInfo {
-                        iterations: Some(r.refinements),
-                        ..SolveInfo::default()
-                    },
-                };
-                (r.x, Some(report))
+                let report = unchecked.is_none().then(|| low_rank_report(&r));
+                (r.x, report)
             } else {
                 // The first symmetric factorization, or the next after the correction outgrew its
                 // columns or its accuracy, becomes the reference (in its own solver).
@@ -1337,54 +1374,91 @@ pub(crate) fn run_incremental(
                     (x, Some(r))
                 }
             };
-            let bwd = report.as_ref().map_or(0.0, |r| r.backward_error);
+            let mut bwd = report.as_ref().map_or(0.0, |r| r.backward_error);
             check_backward_error(&opts.solve, bwd, &format!("increment {step}"))?;
             lap(&mut timings.solve, &mut clock);
             q = disc.generalized(&x, alpha);
-            // Return mapping of every contact.
-            let trials: Vec<Trial> = pairs
-                .par_iter()
-                .with_min_len(256)
-                .enumerate()
-                .map(|(i, p)| {
-                    classify(
-                        p,
-                        Law {
-                            friction,
-                            bonded: opts.bonded,
-                        },
-                        &gather(&q, &p.jump.nodes),
-                        &slips[i],
-                        (states[i], directions[i]),
-                        length_tol,
-                        fixed[i],
-                    )
-                })
-                .collect();
-            let trials: Vec<Trial> = trials
-                .into_iter()
-                .enumerate()
-                .map(|(i, t)| {
-                    if switches[i] >= CHATTER_SWITCHES {
-                        hold(t, states[i], directions[i])
-                    } else {
-                        t
-                    }
-                })
-                .collect();
-            // A slip direction has changed when |Δd| · |u_t − s| exceeds the tolerance (see
-            // SLIP_DIRECTION_TOLERANCE).
-            let changed: Vec<usize> = (0..pairs.len())
-                .filter(|&i| {
-                    let t = &trials[i];
-                    t.state != states[i]
-                        || (t.state == ContactState::Slip
-                            && friction != Friction::None
-                            && t.trial_norm / pairs[i].penalty_tangent
-                                * (t.direction - directions[i]).norm()
-                                > direction_tol)
-                })
-                .collect();
+            // Return mapping of every contact: the trials and the contacts whose state or slip
+            // direction they change.
+            let classify_all = |q: &[f64]| -> (Vec<Trial>, Vec<usize>) {
+                let trials: Vec<Trial> = pairs
+                    .par_iter()
+                    .with_min_len(256)
+                    .enumerate()
+                    .map(|(i, p)| {
+                        classify(
+                            p,
+                            Law {
+                                friction,
+                                bonded: opts.bonded,
+                            },
+                            &gather(&q, &p.jump.nodes),
+                            &slips[i],
+                            (states[i], directions[i]),
+                            length_tol,
+                            fixed[i],
+                        )
+                    })
+                    .collect();
+                let trials: Vec<Trial> = trials
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, t)| {
+                        if switches[i] >= CHATTER_SWITCHES {
+                            hold(t, states[i], directions[i])
+                        } else {
+                            t
+                        }
+                    })
+                    .collect();
+                // A slip direction has changed when |Δd| · |u_t − s| exceeds the tolerance (see
+                // SLIP_DIRECTION_TOLERANCE).
+                let changed: Vec<usize> = (0..pairs.len())
+                    .filter(|&i| {
+                        let t = &trials[i];
+                        t.state != states[i]
+                            || (t.state == ContactState::Slip
+                                && friction != Friction::None
+                                && t.trial_norm / pairs[i].penalty_tangent
+                                    * (t.direction - directions[i]).norm()
+                                    > direction_tol)
+                    })
+                    .collect();
+                (trials, changed)
+            };
+            let (mut trials, mut changed) = classify_all(&q);
+            if let (true, Some(cap)) = (changed.is_empty(), unchecked.take()) {
+                lap(&mut timings.classify, &mut clock);
+                let a0 = backends
+                    .reference
+                    .as_mut()
+                    .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "factorize")))?;
+                let checked = refine_low_rank(
+                    &low_rank,
+                    a0.as_mut(),
+                    &cap,
+                    a,
+                    !nonsymmetric,
+                    &rhs,
+                    tol,
+                    Ok(x),
+                )
+                .map_err(locate)?;
+                lap(&mut timings.factor_reuse, &mut clock);
+                let Some(r) = checked else {
+                    // Not accurate enough: the same states again, on a new reference.
+                    refresh_reference = true;
+                    continue;
+                };
+                reuse_iterations_done += r.refinements;
+                bwd = r.backward_error;
+                check_backward_error(&opts.solve, bwd, &format!("increment {step}"))?;
+                report = Some(low_rank_report(&r));
+                if r.refinements > 0 {
+                    q = disc.generalized(&r.x, alpha);
+                    (trials, changed) = classify_all(&q);
+                }
+            }
             if changed.is_empty() {
                 lap(&mut timings.classify, &mut clock);
                 converged = Some((iteration, trials, report.map(|r| (r.backend, bwd))));
