@@ -449,21 +449,32 @@ fn low_rank_report(r: &LowRankSolve) -> SolveReport {
     }
 }
 
+/// What a low-rank solution of one state iteration is checked against: the assembled matrix A
+/// and load b, and the backward error to reach.
+struct ResidualCheck<'a> {
+    a: CscRef<'a>,
+    symmetric: bool,
+    b: &'a [f64],
+    tolerance: f64,
+}
+
 /// Corrects `first`, a solution of A x = b by the low-rank correction `cap` of the reference
-/// factorization `a0`, with the residual of the assembled `a` until the backward error is at
-/// most `tolerance`; `None` when [`MAX_REFINEMENTS`] steps do not get there (or the
+/// factorization `a0`, with the residual of the assembled A until the backward error is at
+/// most the check's tolerance; `None` when [`MAX_REFINEMENTS`] steps do not get there (or the
 /// capacitance matrix is singular).
-#[allow(clippy::too_many_arguments)]
 fn refine_low_rank(
     low_rank: &LowRankCorrection,
     a0: &mut dyn LinearSolver,
     cap: &Capacitance,
-    a: CscRef<'_>,
-    symmetric: bool,
-    b: &[f64],
-    tolerance: f64,
+    check: &ResidualCheck<'_>,
     first: Result<Vec<f64>, SolverError>,
 ) -> Result<Option<LowRankSolve>, SolverError> {
+    let ResidualCheck {
+        a,
+        symmetric,
+        b,
+        tolerance,
+    } = *check;
     let Ok(mut x) = first else {
         return Ok(None);
     };
@@ -1227,7 +1238,12 @@ pub(crate) fn run_incremental(
             // consistent with it (the states in between only steer the iteration, and the
             // converged solution is checked as every other).
             let mut unchecked: Option<Capacitance> = None;
-            let tol = REUSE_ACCURACY * backward_tolerance(&opts.solve);
+            let check = ResidualCheck {
+                a,
+                symmetric: !nonsymmetric,
+                b: &rhs,
+                tolerance: REUSE_ACCURACY * backward_tolerance(&opts.solve),
+            };
             if let (Some(changes), Some(a0), true) = (
                 changes.as_ref(),
                 backends.reference.as_mut(),
@@ -1277,17 +1293,8 @@ pub(crate) fn run_incremental(
                             unchecked = Some(cap);
                         }
                         first => {
-                            reused = refine_low_rank(
-                                &low_rank,
-                                a0.as_mut(),
-                                &cap,
-                                a,
-                                !nonsymmetric,
-                                &rhs,
-                                tol,
-                                first,
-                            )
-                            .map_err(locate)?;
+                            reused = refine_low_rank(&low_rank, a0.as_mut(), &cap, &check, first)
+                                .map_err(locate)?;
                         }
                     }
                     refresh_reference = reused.is_none();
@@ -1392,7 +1399,7 @@ pub(crate) fn run_incremental(
                                 friction,
                                 bonded: opts.bonded,
                             },
-                            &gather(&q, &p.jump.nodes),
+                            &gather(q, &p.jump.nodes),
                             &slips[i],
                             (states[i], directions[i]),
                             length_tol,
@@ -1433,17 +1440,8 @@ pub(crate) fn run_incremental(
                     .reference
                     .as_mut()
                     .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "factorize")))?;
-                let checked = refine_low_rank(
-                    &low_rank,
-                    a0.as_mut(),
-                    &cap,
-                    a,
-                    !nonsymmetric,
-                    &rhs,
-                    tol,
-                    Ok(x),
-                )
-                .map_err(locate)?;
+                let checked =
+                    refine_low_rank(&low_rank, a0.as_mut(), &cap, &check, Ok(x)).map_err(locate)?;
                 lap(&mut timings.factor_reuse, &mut clock);
                 let Some(r) = checked else {
                     // Not accurate enough: the same states again, on a new reference.
