@@ -35,4 +35,15 @@ impl<'a, T> SharedMut<'a, T> {
         // SAFETY: in bounds; exclusivity is the caller's contract.
         unsafe { &mut *self.ptr.add(i) }
     }
+
+    /// The `N` entries from `start` on.
+    ///
+    /// # Safety
+    /// As [`SharedMut::get`], for every index of the run. The run is bounds checked.
+    #[allow(clippy::mut_from_ref)]
+    pub(crate) unsafe fn run<const N: usize>(&self, start: usize) -> &mut [T; N] {
+        assert!(start + N <= self.len, "run {start}+{N} out of {}", self.len);
+        // SAFETY: in bounds; exclusivity is the caller's contract.
+        unsafe { &mut *self.ptr.add(start).cast::<[T; N]>() }
+    }
 }

@@ -49,13 +49,26 @@ impl Sink<'_> {
     ) -> Option<Matrix6> {
         let m = 6 * gnodes.len();
         if !gnodes.contains(&self.driver) {
-            // No driver node (all blocks but a few): every entry goes to its slot.
+            // No driver node (all blocks but a few): every entry goes to its slot. A node's six
+            // rows of a column are six adjacent slots when its DOFs are all free (sorted rows:
+            // the last is the first + 5 exactly then), added as one run.
             for c in 0..m {
-                for r in 0..m {
-                    let s = slots[r * m + c];
-                    if s != NO_SLOT {
-                        // SAFETY: as below, the slot couples two nodes of this block only.
-                        unsafe { *self.values.get(s as usize) += k(r, c) };
+                for r0 in (0..m).step_by(6) {
+                    let first = slots[r0 * m + c];
+                    if first != NO_SLOT && slots[(r0 + 5) * m + c] == first + 5 {
+                        // SAFETY: as below, the slots couple two nodes of this block only.
+                        let run = unsafe { self.values.run::<6>(first as usize) };
+                        for (d, v) in run.iter_mut().enumerate() {
+                            *v += k(r0 + d, c);
+                        }
+                        continue;
+                    }
+                    for r in r0..r0 + 6 {
+                        let s = slots[r * m + c];
+                        if s != NO_SLOT {
+                            // SAFETY: as below, the slot couples two nodes of this block only.
+                            unsafe { *self.values.get(s as usize) += k(r, c) };
+                        }
                     }
                 }
             }
