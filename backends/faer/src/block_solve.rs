@@ -45,13 +45,30 @@ impl SolveSchedule {
         self.tasks.len() > 1
     }
 
+    /// Per block of a tree with `blocks` blocks: the task whose subtrees hold it, or `NONE`
+    /// for the top blocks (every block when the schedule is not parallel).
+    pub(crate) fn task_of(&self, blocks: usize) -> Vec<usize> {
+        let mut task_of = vec![NONE; blocks];
+        for (t, task) in self.tasks.iter().enumerate() {
+            for &s in task {
+                task_of[s] = t;
+            }
+        }
+        task_of
+    }
+
+    /// The number of tasks (threads) the subtrees are split into; 0 when not parallel.
+    pub(crate) fn task_count(&self) -> usize {
+        self.tasks.len()
+    }
+
     /// Balances the subtrees of `tree` over `threads` by the number of factor values.
     pub(crate) fn new(tree: &BlockTree, threads: usize) -> Self {
         Self::with_threshold(tree, threads, PARALLEL_VALUES)
     }
 
     /// The same, on one thread when the factor has fewer than `parallel_values` values.
-    fn with_threshold(tree: &BlockTree, threads: usize, parallel_values: usize) -> Self {
+    pub(crate) fn with_threshold(tree: &BlockTree, threads: usize, parallel_values: usize) -> Self {
         let blocks = tree.parent.len();
         let own: Vec<usize> = tree.shapes.iter().map(|b| b.values.len()).collect();
         let mut weight = own.clone();
@@ -336,24 +353,24 @@ pub(crate) fn backward_in_place(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sparse_forward::tests::grid;
-    use crate::{CholeskyVariant, FaerCholesky};
-    use fibercell_solver::{LinearSolver, Ordering};
+    use crate::sparse_forward::tests::grid_factor;
+    use crate::sparse_forward::FactorView;
+    use fibercell_solver::LinearSolver;
 
     /// The block solve on 1 thread and with subtrees on 2 and 3 threads gives faer's solution
     /// (1e-12) on a supernodal ND factor, with a backward error ≤ 1e-14.
     #[test]
     fn block_solve_on_one_to_three_threads_gives_faers_solution() {
-        let k = 16;
-        let n = k * k * k;
-        let a = grid(k);
-        let mut s = FaerCholesky::new(CholeskyVariant::Llt, Ordering::NestedDissection);
-        s.analyze(a.as_ref()).unwrap();
-        s.factorize(a.as_ref()).unwrap();
+        let (n, a, mut s) = grid_factor(16);
         let b: Vec<f64> = (0..n).map(|i| ((i * 53) % 29) as f64 - 14.0).collect();
         let mut want = [b.clone(), b.clone()].concat();
         s.solve_in_place(&mut want, 2).unwrap();
-        let (symbolic, values, inv, scale) = s.factor_parts();
+        let FactorView {
+            symbolic,
+            values,
+            inv,
+            scale,
+        } = s.factor_view();
         let tree = BlockTree::of(symbolic);
         for threads in [1, 2, 3] {
             let schedule = SolveSchedule::with_threshold(&tree, threads, 0);

@@ -9,7 +9,7 @@ use crate::block_solve::{
     backward_in_place, forward_in_place, solve_in_place as block_solve, SolveSchedule,
 };
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
-use crate::sparse_forward::BlockTree;
+use crate::sparse_forward::{BlockTree, FactorView};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
@@ -103,12 +103,17 @@ impl FaerCholesky {
 
     /// The symbolic factor, L's values, the inverse permutation and the scaling (tests).
     #[cfg(test)]
-    pub(crate) fn factor_parts(&self) -> (&SymbolicCholesky<usize>, &[f64], &[usize], &[f64]) {
+    pub(crate) fn factor_view(&self) -> FactorView<'_> {
         let (an, f) = (
             self.analysis.as_ref().unwrap(),
             self.factor.as_ref().unwrap(),
         );
-        (&an.symbolic, &f.l_values, &an.factor_inv, &f.scale)
+        FactorView {
+            symbolic: &an.symbolic,
+            values: &f.l_values,
+            inv: &an.factor_inv,
+            scale: &f.scale,
+        }
     }
 
     /// The analysis and an LLᵀ factor, for the half and sparse solves.
@@ -426,13 +431,12 @@ impl LinearSolver for FaerCholesky {
         columns: &[Vec<(usize, f64)>],
     ) -> Result<ForwardColumns, SolverError> {
         let (an, f) = self.llt_parts()?;
-        an.tree.forward(
-            &an.symbolic,
-            &f.l_values,
-            &an.factor_inv,
-            &f.scale,
-            columns,
-            self.par,
-        )
+        let factor = FactorView {
+            symbolic: &an.symbolic,
+            values: &f.l_values,
+            inv: &an.factor_inv,
+            scale: &f.scale,
+        };
+        an.tree.forward(&factor, columns, &an.schedule, self.par)
     }
 }

@@ -1,17 +1,31 @@
 //! Forward solves with sparse right-hand sides on faer's Cholesky factor, restricted to the
 //! elimination-tree paths of the nonzeros (Gilbert–Peierls reach, by blocks of L).
 
+use crate::block_solve::SolveSchedule;
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::{Accum, MatMut, MatRef, Par};
 use fibercell_solver::{ForwardBlock, ForwardColumns, SolverError};
+use rayon::prelude::*;
 use std::ops::Range;
 
 pub(crate) const NONE: usize = usize::MAX;
 
 /// Products of a block below which the dense kernels run single-threaded.
 const PARALLEL_FLOPS: usize = 1 << 20;
+
+/// A numeric LLᵀ factor as the solves read it.
+#[derive(Clone, Copy)]
+pub(crate) struct FactorView<'a> {
+    pub(crate) symbolic: &'a SymbolicCholesky<usize>,
+    /// The values of L.
+    pub(crate) values: &'a [f64],
+    /// The inverse fill-reducing permutation, `inv[old] = new`.
+    pub(crate) inv: &'a [usize],
+    /// The scaling Ŝ.
+    pub(crate) scale: &'a [f64],
+}
 
 /// The block tree of a factor: faer's supernodes, or single columns for a simplicial factor.
 pub(crate) struct BlockTree {
@@ -124,17 +138,21 @@ impl BlockTree {
         }
     }
 
-    /// W = L⁻¹ P Ŝ B for the sparse columns `columns` (original row numbering), `inv` the
-    /// inverse permutation (`inv[old] = new`), `scale` Ŝ.
+    /// W = L⁻¹ P Ŝ B for the sparse columns `columns` (original row numbering) on `factor`,
+    /// the subtrees of `schedule` on separate threads.
     pub(crate) fn forward(
         &self,
-        symbolic: &SymbolicCholesky<usize>,
-        values: &[f64],
-        inv: &[usize],
-        scale: &[f64],
+        factor: &FactorView<'_>,
         columns: &[Vec<(usize, f64)>],
+        schedule: &SolveSchedule,
         par: Par,
     ) -> Result<ForwardColumns, SolverError> {
+        let FactorView {
+            symbolic,
+            values,
+            inv,
+            scale,
+        } = *factor;
         let n = self.block_of.len();
         // The reach: every block on a path from a column's nonzeros to the root.
         let mut members: Vec<Vec<usize>> = vec![Vec::new(); self.parent.len()];
@@ -162,10 +180,11 @@ impl BlockTree {
         for (k, &s) in touched.iter().enumerate() {
             slot[s] = k;
         }
-        let mut x: Vec<Vec<f64>> = touched
+        let x_len: Vec<usize> = touched
             .iter()
-            .map(|&s| vec![0.0; self.block(symbolic, values, s).width * members[s].len()])
+            .map(|&s| self.shapes[s].width * members[s].len())
             .collect();
+        let mut x: Vec<Vec<f64>> = x_len.iter().map(|&n| vec![0.0; n]).collect();
         for (j, col) in columns.iter().enumerate() {
             for &(i, v) in col {
                 let p = inv[i];
@@ -175,18 +194,125 @@ impl BlockTree {
                 x[slot[s]][c * b.width + p - b.begin] += v * scale[i];
             }
         }
+        // Groups: the touched blocks of each task of `schedule` (disjoint subtrees, one thread
+        // each) and the top ones, each ascending (children before parents). A block's
+        // ancestors are in its own group or among the top blocks; a task adds to the top
+        // blocks in private copies, summed before the top blocks follow.
+        let task_of = schedule.task_of(self.parent.len());
+        let top = schedule.task_count();
+        let group_of: Vec<usize> = touched
+            .iter()
+            .map(|&s| match task_of[s] {
+                NONE => top,
+                t => t,
+            })
+            .collect();
+        let mut lists: Vec<Vec<usize>> = vec![Vec::new(); top + 1];
+        let mut index = vec![0; touched.len()];
+        for (k, &g) in group_of.iter().enumerate() {
+            index[k] = lists[g].len();
+            lists[g].push(k);
+        }
+        let mut groups: Vec<Vec<Vec<f64>>> = lists
+            .iter()
+            .map(|list| list.iter().map(|&k| std::mem::take(&mut x[k])).collect())
+            .collect();
+        let top_sizes: Vec<usize> = lists[top].iter().map(|&k| x_len[k]).collect();
+        let walk = Walk {
+            tree: self,
+            symbolic,
+            values,
+            touched: &touched,
+            members: &members,
+            slot: &slot,
+            group_of: &group_of,
+            index: &index,
+            par,
+        };
+        let (tasks, top_group) = groups.split_at_mut(top);
+        let copies: Vec<Vec<Vec<f64>>> = tasks
+            .par_iter_mut()
+            .zip(&lists[..top])
+            .enumerate()
+            .map(|(g, (mine, list))| {
+                let mut copy: Vec<Vec<f64>> = top_sizes.iter().map(|&n| vec![0.0; n]).collect();
+                walk.eliminate(g, list, mine, Some(&mut copy));
+                copy
+            })
+            .collect();
+        let top_xs = &mut top_group[0];
+        for copy in copies {
+            for (xt, c) in top_xs.iter_mut().zip(copy) {
+                xt.iter_mut().zip(c).for_each(|(a, b)| *a += b);
+            }
+        }
+        walk.eliminate(top, &lists[top], top_xs, None);
+        for (list, group) in lists.iter().zip(groups) {
+            for (&k, xk) in list.iter().zip(group) {
+                x[k] = xk;
+            }
+        }
+        let blocks = touched
+            .iter()
+            .zip(x)
+            .map(|(&s, values_s)| ForwardBlock {
+                block: s,
+                first_row: self.shapes[s].begin,
+                rows: self.shapes[s].width,
+                columns: std::mem::take(&mut members[s]),
+                values: values_s,
+            })
+            .collect();
+        Ok(ForwardColumns {
+            ncols: columns.len(),
+            blocks,
+        })
+    }
+}
+
+/// What eliminating the touched blocks of one group needs.
+struct Walk<'a> {
+    tree: &'a BlockTree,
+    symbolic: &'a SymbolicCholesky<usize>,
+    values: &'a [f64],
+    /// The touched blocks, ascending.
+    touched: &'a [usize],
+    /// Per block: the columns that reach it, ascending.
+    members: &'a [Vec<usize>],
+    /// Per block: its position in `touched`, or `NONE`.
+    slot: &'a [usize],
+    /// Per touched block: its group (a task, or the top).
+    group_of: &'a [usize],
+    /// Per touched block: its position in its group.
+    index: &'a [usize],
+    par: Par,
+}
+
+impl Walk<'_> {
+    /// Eliminates the touched blocks `list` of group `group` (ascending), their solutions
+    /// `mine` (in list order): each block's rows solved, its rows below subtracted from its
+    /// ancestors' — in `mine`, or for top blocks of another group in `top_copy` (by their
+    /// position among the top blocks).
+    fn eliminate(
+        &self,
+        group: usize,
+        list: &[usize],
+        mine: &mut [Vec<f64>],
+        mut top_copy: Option<&mut Vec<Vec<f64>>>,
+    ) {
         let mut below = Vec::new();
         let mut position = Vec::new();
-        for (k, &s) in touched.iter().enumerate() {
-            let b = self.block(symbolic, values, s);
-            let m = members[s].len();
+        for (i, &k) in list.iter().enumerate() {
+            let s = self.touched[k];
+            let b = self.tree.block(self.symbolic, self.values, s);
+            let m = self.members[s].len();
             let rows = b.width + b.pattern.len();
             let l = MatRef::from_column_major_slice(b.values, rows, b.width);
             let (top, bottom) = l.split_at_row(b.width);
-            let (done, rest) = x.split_at_mut(k + 1);
-            let xs = &mut done[k];
+            let (done, rest) = mine.split_at_mut(i + 1);
+            let xs = &mut done[i];
             let kernel_par = if rows * b.width * m > PARALLEL_FLOPS {
-                par
+                self.par
             } else {
                 Par::Seq
             };
@@ -211,48 +337,53 @@ impl BlockTree {
             // Subtract from the ancestors' rows; this block's columns are among theirs.
             let mut last = NONE;
             for (r, &row) in b.pattern.iter().enumerate() {
-                let t = self.block_of[row];
+                let t = self.tree.block_of[row];
                 if t != last {
                     last = t;
                     position.clear();
                     let mut at = 0;
-                    for &j in &members[s] {
-                        while members[t][at] != j {
+                    for &j in &self.members[s] {
+                        while self.members[t][at] != j {
                             at += 1;
                         }
                         position.push(at);
                     }
                 }
-                let bt = self.block(symbolic, values, t);
-                let xt = &mut rest[slot[t] - k - 1];
+                let kt = self.slot[t];
+                let xt = if self.group_of[kt] == group {
+                    &mut rest[self.index[kt] - i - 1]
+                } else {
+                    match top_copy.as_deref_mut() {
+                        Some(copy) => &mut copy[self.index[kt]],
+                        // The top group's ancestors are top blocks.
+                        None => unreachable!("an ancestor outside the top group"),
+                    }
+                };
+                let bt = self.tree.block(self.symbolic, self.values, t);
                 let local = row - bt.begin;
                 for (c, &at) in position.iter().enumerate() {
                     xt[at * bt.width + local] -= below[c * b.pattern.len() + r];
                 }
             }
         }
-        let blocks = touched
-            .iter()
-            .zip(x)
-            .map(|(&s, values_s)| ForwardBlock {
-                block: s,
-                first_row: self.shapes[s].begin,
-                rows: self.shapes[s].width,
-                columns: std::mem::take(&mut members[s]),
-                values: values_s,
-            })
-            .collect();
-        Ok(ForwardColumns {
-            ncols: columns.len(),
-            blocks,
-        })
     }
 }
 
 #[cfg(test)]
 pub(crate) mod tests {
+    use super::BlockTree;
     use crate::{CholeskyVariant, FaerCholesky};
+    use faer::Par;
     use fibercell_solver::{CscMatrix, LinearSolver, Ordering, SolverError};
+
+    /// The order, the matrix and the supernodal nested-dissection LLᵀ factor of `grid(k)`.
+    pub(crate) fn grid_factor(k: usize) -> (usize, CscMatrix, FaerCholesky) {
+        let a = grid(k);
+        let mut s = FaerCholesky::new(CholeskyVariant::Llt, Ordering::NestedDissection);
+        s.analyze(a.as_ref()).unwrap();
+        s.factorize(a.as_ref()).unwrap();
+        (k * k * k, a, s)
+    }
 
     /// A k³ grid Laplacian with edge weights and diagonal scales spread over four decades.
     pub(crate) fn grid(k: usize) -> CscMatrix {
@@ -347,6 +478,38 @@ pub(crate) mod tests {
                 assert!(w.blocks.iter().all(|blk| !blk.columns.contains(&5)));
                 if supernodal && ordering == Ordering::NestedDissection {
                     assert!(w.nnz() < b.len() * n / 4, "{} of {}", w.nnz(), b.len() * n);
+                }
+            }
+        }
+    }
+
+    /// With the subtrees of the block tree on 2 and 3 tasks (their updates of the top blocks
+    /// in private copies) the sparse forward solve gives the one-group result: the same blocks
+    /// and columns, values to 1e-12.
+    #[test]
+    fn sparse_forward_solve_on_subtree_tasks_matches_one_group() {
+        use crate::block_solve::SolveSchedule;
+        let (n, _, s) = grid_factor(16);
+        let factor = s.factor_view();
+        let tree = BlockTree::of(factor.symbolic);
+        let b = columns(n);
+        let forward =
+            |schedule: &SolveSchedule| tree.forward(&factor, &b, schedule, Par::Seq).unwrap();
+        let one = forward(&SolveSchedule::with_threshold(&tree, 1, 0));
+        for threads in [2, 3] {
+            let schedule = SolveSchedule::with_threshold(&tree, threads, 0);
+            assert_eq!(schedule.task_count(), threads);
+            let got = forward(&schedule);
+            assert_eq!(got.blocks.len(), one.blocks.len());
+            let big = one
+                .blocks
+                .iter()
+                .flat_map(|blk| &blk.values)
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            for (g, w) in got.blocks.iter().zip(&one.blocks) {
+                assert_eq!((g.block, &g.columns), (w.block, &w.columns));
+                for (x, y) in g.values.iter().zip(&w.values) {
+                    assert!((x - y).abs() <= 1e-12 * big, "{threads} tasks: {x} vs {y}");
                 }
             }
         }
