@@ -11,4 +11,4 @@ pub use coloring::{color_blocks, color_elements};
 pub use dof_map::{block_starts, DofMap};
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
 pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};
-pub(crate) use shared::SharedMut;
+pub(crate) use shared::{prefetch, SharedMut};

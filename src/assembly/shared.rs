@@ -1,5 +1,6 @@
 //! A slice that parallel tasks write to at disjoint indices: the colored fills, where no two
-//! elements (or contacts) of one color touch the same entry.
+//! elements of one color touch the same entry, and the node-owned contact fill, where each task
+//! writes its own node's columns.
 
 use std::marker::PhantomData;
 
@@ -36,6 +37,15 @@ impl<'a, T> SharedMut<'a, T> {
         unsafe { &mut *self.ptr.add(i) }
     }
 
+    /// Hints the CPU to bring entry `i` into the cache (no effect when `i` is out of range).
+    #[inline]
+    pub(crate) fn prefetch(&self, i: usize) {
+        if i < self.len {
+            // SAFETY: the address is inside the slice.
+            prefetch(unsafe { self.ptr.add(i) });
+        }
+    }
+
     /// The `N` entries from `start` on.
     ///
     /// # Safety
@@ -46,4 +56,18 @@ impl<'a, T> SharedMut<'a, T> {
         // SAFETY: in bounds; exclusivity is the caller's contract.
         unsafe { &mut *self.ptr.add(start).cast::<[T; N]>() }
     }
+}
+
+/// Hints the CPU to bring the cache line at `p` into the cache (nothing off x86-64). A prefetch
+/// never faults, whatever the address.
+#[inline]
+pub(crate) fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch has no architectural effect and never faults.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(p.cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }

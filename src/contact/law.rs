@@ -20,7 +20,7 @@
 //! at right angles its two vectors are the two fiber tangents of the thesis.
 
 use super::kinematics::Jump;
-use nalgebra::{SMatrix, SVector, Vector2, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector2, Vector3};
 
 /// A 30 × 30 contact block (the top-left 6k × 6k part is used).
 pub type BlockMatrix = SMatrix<f64, 30, 30>;
@@ -157,16 +157,20 @@ impl ContactPair {
     /// S = p_N n nᵀ (+ p_T (t₁t₁ᵀ + t₂t₂ᵀ)), six products per entry and no 30 × 30 temporaries
     /// (the value fill of closed contacts).
     pub fn closed_stiffness(&self, stick: bool) -> impl Fn(usize, usize) -> f64 + Sync + '_ {
-        let n = &self.normal;
-        let mut s = n * n.transpose() * self.penalty_normal;
-        if stick {
-            for t in &self.tangents {
-                s += t * t.transpose() * self.penalty_tangent;
-            }
-        }
-        let sb = s * self.jump.b;
+        let sb = self.jump_stiffness(stick) * self.jump.b;
         let (b, r, pr) = (&self.jump.b, &self.jump.r, self.penalty_rotation);
         move |i, j| b.column(i).dot(&sb.column(j)) + pr * r.column(i).dot(&r.column(j))
+    }
+
+    /// The 3 × 3 S = p_N n nᵀ (+ p_T (t₁t₁ᵀ + t₂t₂ᵀ) when `stick`) of
+    /// [`ContactPair::closed_stiffness`]: the jump's stiffness.
+    #[inline]
+    pub fn jump_stiffness(&self, stick: bool) -> Matrix3<f64> {
+        let (n, [t1, t2]) = (&self.normal, &self.tangents);
+        let p_t = if stick { self.penalty_tangent } else { 0.0 };
+        Matrix3::from_fn(|i, j| {
+            self.penalty_normal * (n[i] * n[j]) + p_t * (t1[i] * t1[j] + t2[i] * t2[j])
+        })
     }
 
     /// F_N + F_T of a stuck contact with accumulated slip `slip` (4.53, 4.58), the load that

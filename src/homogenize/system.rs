@@ -6,6 +6,7 @@
 //! (K_N + K_T^st, plus the rolling resistance K_R): the elastic moduli A^elas of thesis (5.5).
 //! Contacts are searched with the periodic images, so crossings on the boundary count.
 
+use super::contact_columns::ContactColumns;
 use crate::assembly::{color_blocks, element_stiffness, Pattern, SharedMut, NO_SLOT};
 use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain, Periodicity};
 use crate::constraints::Discretization;
@@ -135,11 +136,11 @@ pub struct PeriodicSystem {
     pub pattern: Pattern,
     /// Per element: its generalized nodes and T, None when T = I on its own nodes.
     elements: Vec<Option<(Vec<usize>, DMatrix<f64>)>>,
-    contacts: Vec<ContactPair>,
+    pub(super) contacts: Vec<ContactPair>,
     /// Elements by color: no two of a color share a generalized node other than the driver.
     element_colors: Vec<Vec<usize>>,
-    /// Closed contacts by color, likewise.
-    contact_colors: Vec<Vec<usize>>,
+    /// Closed contacts by the nodes whose columns they fill.
+    pub(super) contact_columns: ContactColumns,
     /// The node whose translations are fixed.
     pub anchor: usize,
     /// How long building it took.
@@ -222,12 +223,6 @@ impl PeriodicSystem {
         let (driver, n_gnodes) = (discretization.driver(), discretization.n_gnodes());
         let element_colors =
             color_blocks(n_gnodes, blocks[..elements.len()].iter().copied(), driver);
-        let mut contact_colors =
-            color_blocks(n_gnodes, blocks[elements.len()..].iter().copied(), driver);
-        // Within a color, by first node: neighbouring contacts write neighbouring columns.
-        for color in &mut contact_colors {
-            color.sort_by_key(|&i| contacts[i].jump.nodes.iter().min().copied());
-        }
         timings.blocks = clock.elapsed().as_secs_f64();
         let clock = std::time::Instant::now();
         let pattern = Pattern::from_blocks(
@@ -236,6 +231,7 @@ impl PeriodicSystem {
             &blocks,
             elements.len(),
         )?;
+        let contact_columns = ContactColumns::new(n_gnodes, driver, &contacts, &pattern);
         timings.pattern = clock.elapsed().as_secs_f64();
         Ok(PeriodicSystem {
             periodicity,
@@ -244,7 +240,7 @@ impl PeriodicSystem {
             elements,
             contacts,
             element_colors,
-            contact_colors,
+            contact_columns,
             anchor,
             timings,
         })
@@ -350,18 +346,22 @@ impl PeriodicSystem {
         });
     }
 
-    /// Adds the closed contacts, contact i with the stiffness `which(i)`; colored and parallel
-    /// as [`PeriodicSystem::add_elements`].
+    /// Adds the closed contacts, contact i with the stiffness `which(i)`: node by node in
+    /// parallel, each node's task filling its own columns (see `ContactColumns`), so the sums do
+    /// not depend on the number of threads.
     pub fn add_contacts(
         &self,
         out: &mut PeriodicValues,
         which: impl Fn(usize) -> ContactStiffness + Sync,
     ) {
-        self.add_colored(out, &self.contact_colors, |i, sink| {
-            let pair = &self.contacts[i];
-            let k = pair.closed_stiffness(which(i) == ContactStiffness::Stick);
-            sink.add(&pair.jump.nodes, k, self.pattern.extra_slots(i))
-        });
+        out.k_ee += self.contact_columns.add(
+            &self.contacts,
+            &self.pattern,
+            &self.discretization,
+            &mut out.values,
+            &mut out.coupling,
+            |i| self.contacts[i].jump_stiffness(which(i) == ContactStiffness::Stick),
+        );
     }
 
     /// Runs `block(i, sink)` for the blocks of each color in parallel, colors in order; the
