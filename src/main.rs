@@ -129,7 +129,8 @@ enum Command {
         /// Write the Markdown tables here too.
         #[arg(long)]
         markdown: Option<PathBuf>,
-        /// Repeats of each stage (medians are reported).
+        /// Repeats of each stage (medians are reported; contact search and value fills at
+        /// least 15).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
         /// Generator seed.

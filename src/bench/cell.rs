@@ -21,6 +21,10 @@ use fibercell_solver::{backward_error, pcg_with_factor, CscRef, Ordering};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
+/// Repeats at least of the stages that take milliseconds (contact search, value fills), whose
+/// medians over a few runs still follow the noise of a shared machine.
+const SHORT_STAGE_REPEATS: usize = 15;
+
 /// Median of non-empty `times` (the upper one of an even count); 0 when empty.
 fn median(mut times: Vec<f64>) -> f64 {
     times.sort_by(f64::total_cmp);
@@ -527,10 +531,11 @@ pub fn bench_cell(
     let periodicity = pair_boundary_nodes(&model)?;
     let tolerance = model.contact.as_ref().map_or(0.0, |c| c.tolerance);
     log(&format!("{cell}: contact search"));
-    let (contact_search, _) = median_of(opts.repeats, || {
+    let short_repeats = opts.repeats.max(SHORT_STAGE_REPEATS);
+    let (contact_search, _) = median_of(short_repeats, || {
         Ok(find_candidates(&model, tolerance, Some(&periodicity)))
     })?;
-    let (contact_set, _) = median_of(opts.repeats, || {
+    let (contact_set, _) = median_of(short_repeats, || {
         Ok(ContactSet::build_with(&model, Some(&periodicity))?)
     })?;
     log(&format!("{cell}: pattern and fill"));
@@ -540,7 +545,7 @@ pub fn bench_cell(
     let mut buffer = sys.zero_values();
     let mut refill = |add: &dyn Fn(&mut crate::homogenize::PeriodicValues)| {
         median(
-            (0..opts.repeats.max(1))
+            (0..short_repeats)
                 .map(|_| {
                     buffer.values.fill(0.0);
                     let t = Instant::now();

@@ -26,7 +26,8 @@ pub struct BenchOptions {
     pub cells: Vec<String>,
     /// Seed of the generator.
     pub seed: u64,
-    /// Repeats of each timed stage (the median is reported).
+    /// Repeats of each timed stage (the median is reported); the millisecond stages (contact
+    /// search and set, value fills) run at least 15 times.
     pub repeats: usize,
     /// Increments of the elasto-plastic curve (0: skip it).
     pub curve_steps: usize,
