@@ -758,14 +758,17 @@ impl Elastic {
         if self.identity {
             return internal_forces(model, &q[..6 * model.nodes.len()]);
         }
+        // Column by column, a node's six rows at a time (contiguous in K and in `out`).
         let add = |out: &mut [f64], e: usize, k: &DMatrix<f64>| {
             let gnodes = self.gnodes_of(model, e);
-            let dof = |c: usize| 6 * gnodes[c / 6] + c % 6;
-            for (c, column) in k.column_iter().enumerate() {
-                let qc = q[dof(c)];
-                if qc != 0.0 {
-                    for (r, v) in column.iter().enumerate() {
-                        out[dof(r)] += v * qc;
+            for (c, column) in k.as_slice().chunks_exact(k.nrows()).enumerate() {
+                let qc = q[6 * gnodes[c / 6] + c % 6];
+                if qc == 0.0 {
+                    continue;
+                }
+                for (&g, rows) in gnodes.iter().zip(column.chunks_exact(6)) {
+                    for (o, v) in out[6 * g..6 * g + 6].iter_mut().zip(rows) {
+                        *o += v * qc;
                     }
                 }
             }
