@@ -161,6 +161,13 @@ impl Pattern {
     pub fn extra_slots(&self, b: usize) -> &[u32] {
         self.block_slots(self.n_elements + b)
     }
+    /// The slot of the first of rows `r0..r0 + 6` (one node's six DOFs) in column `c` of an
+    /// m × m block slot map `slots`, when the six are adjacent slots — all six DOFs free: rows
+    /// are sorted, so the last is then exactly the first + 5 — otherwise `None`.
+    pub fn row_run(slots: &[u32], m: usize, r0: usize, c: usize) -> Option<u32> {
+        let first = slots[r0 * m + c];
+        (first != NO_SLOT && slots[(r0 + 5) * m + c] == first + 5).then_some(first)
+    }
     fn block_slots(&self, b: usize) -> &[u32] {
         &self.slots[self.block_offsets[b]..self.block_offsets[b + 1]]
     }

@@ -82,11 +82,7 @@ impl ContactColumns {
                 for (d, column) in runs.iter_mut().enumerate() {
                     let c = 6 * a + d;
                     for (b, run) in column.iter_mut().take(m / 6).enumerate() {
-                        let first = slots[6 * b * m + c];
-                        // Sorted rows: the sixth is the first + 5 only when all six are there.
-                        if first != NO_SLOT && slots[(6 * b + 5) * m + c] == first + 5 {
-                            *run = first;
-                        }
+                        *run = Pattern::row_run(slots, m, 6 * b, c).unwrap_or(NO_SLOT);
                     }
                 }
                 incidences[next[g]] = Incidence {

@@ -109,6 +109,14 @@ pub struct PressureResponse {
     pub displacements: Vec<[f64; 6]>,
 }
 
+/// Seconds since `clock`, which restarts.
+fn lap_seconds(clock: &mut std::time::Instant) -> f64 {
+    let now = std::time::Instant::now();
+    let t = (now - *clock).as_secs_f64();
+    *clock = now;
+    t
+}
+
 /// The cell matrix of `model` with all closed contacts stuck, assembled, analysed and
 /// factorized: the system, its values and the factorization (stages timed into `timings`).
 fn factor_cell(
@@ -117,12 +125,7 @@ fn factor_cell(
     timings: &mut HomogenizeTimings,
 ) -> Result<(PeriodicSystem, PeriodicValues, Box<dyn LinearSolver>), Error> {
     let mut clock = std::time::Instant::now();
-    let mut lap = || {
-        let now = std::time::Instant::now();
-        let t = (now - clock).as_secs_f64();
-        clock = now;
-        t
-    };
+    let mut lap = || lap_seconds(&mut clock);
     let sys = PeriodicSystem::new(model)?;
     timings.setup = lap();
     let vals = sys.assemble(model);
@@ -182,12 +185,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
     let mut timings = HomogenizeTimings::default();
     let (sys, vals, mut solver) = factor_cell(model, options, &mut timings)?;
     let mut clock = std::time::Instant::now();
-    let mut lap = || {
-        let now = std::time::Instant::now();
-        let t = (now - clock).as_secs_f64();
-        clock = now;
-        t
-    };
+    let mut lap = || lap_seconds(&mut clock);
     let n = sys.n_free();
     let a = sys.pattern.matrix(&vals.values)?;
     let locate = |e: SolverError| sys.locate(model, e);

@@ -50,13 +50,11 @@ impl Sink<'_> {
     ) -> Option<Matrix6> {
         let m = 6 * gnodes.len();
         if !gnodes.contains(&self.driver) {
-            // No driver node (all blocks but a few): every entry goes to its slot. A node's six
-            // rows of a column are six adjacent slots when its DOFs are all free (sorted rows:
-            // the last is the first + 5 exactly then), added as one run.
+            // No driver node (all blocks but a few): every entry goes to its slot, a node's six
+            // rows of a column as one run when they are adjacent slots (`Pattern::row_run`).
             for c in 0..m {
                 for r0 in (0..m).step_by(6) {
-                    let first = slots[r0 * m + c];
-                    if first != NO_SLOT && slots[(r0 + 5) * m + c] == first + 5 {
+                    if let Some(first) = Pattern::row_run(slots, m, r0, c) {
                         // SAFETY: as below, the slots couple two nodes of this block only.
                         let run = unsafe { self.values.run::<6>(first as usize) };
                         for (d, v) in run.iter_mut().enumerate() {

@@ -656,13 +656,6 @@ impl Elastic {
         }
     }
 
-    fn gnodes(&self, model: &Model, e: usize) -> Vec<usize> {
-        match &self.maps[e] {
-            Some((g, _)) => g.clone(),
-            None => model.elements()[e].nodes.to_vec(),
-        }
-    }
-
     /// Tᵀ K T of element e on its generalized nodes.
     fn matrix(&self, model: &Model, e: usize) -> DMatrix<f64> {
         let k = element_stiffness(model, e);
@@ -728,7 +721,7 @@ impl Elastic {
             }
         }
         for e in 0..self.maps.len() {
-            let gnodes = self.gnodes(model, e);
+            let gnodes = self.gnodes_of(model, e);
             let prescribed = |c: usize| {
                 let g = 6 * gnodes[c / 6] + c % 6;
                 disc.reduced(g)
@@ -869,7 +862,7 @@ pub(crate) fn run_incremental(
     let pairs: Vec<ContactPair> = set.pairs.iter().map(|p| disc.contact_pair(p)).collect();
     let elastic = Elastic::new(model, disc);
     let mut blocks: Vec<Vec<usize>> = (0..model.elements().len())
-        .map(|e| elastic.gnodes(model, e))
+        .map(|e| elastic.gnodes_of(model, e).to_vec())
         .collect();
     blocks.extend(pairs.iter().map(|p| p.jump.nodes.clone()));
     let block_refs: Vec<&[usize]> = blocks.iter().map(|b| &b[..]).collect();

@@ -75,6 +75,16 @@ impl Default for FaerCholesky {
     }
 }
 
+/// The LLᵀ factor `f` of the analysis `an` as the solves read it.
+fn factor_view<'a>(an: &'a Analysis, f: &'a Factor) -> FactorView<'a> {
+    FactorView {
+        symbolic: &an.symbolic,
+        values: &f.l_values,
+        inv: &an.factor_inv,
+        scale: &f.scale,
+    }
+}
+
 impl FaerCholesky {
     /// A solver with the given variant and ordering, relative pivot tolerance 1e-12 and all
     /// rayon threads.
@@ -104,16 +114,8 @@ impl FaerCholesky {
     /// The symbolic factor, L's values, the inverse permutation and the scaling (tests).
     #[cfg(test)]
     pub(crate) fn factor_view(&self) -> FactorView<'_> {
-        let (an, f) = (
-            self.analysis.as_ref().unwrap(),
-            self.factor.as_ref().unwrap(),
-        );
-        FactorView {
-            symbolic: &an.symbolic,
-            values: &f.l_values,
-            inv: &an.factor_inv,
-            scale: &f.scale,
-        }
+        let (an, f) = self.llt_parts().expect("an LLᵀ factor");
+        factor_view(an, f)
     }
 
     /// The analysis and an LLᵀ factor, for the half and sparse solves.
@@ -431,12 +433,7 @@ impl LinearSolver for FaerCholesky {
         columns: &[Vec<(usize, f64)>],
     ) -> Result<ForwardColumns, SolverError> {
         let (an, f) = self.llt_parts()?;
-        let factor = FactorView {
-            symbolic: &an.symbolic,
-            values: &f.l_values,
-            inv: &an.factor_inv,
-            scale: &f.scale,
-        };
-        an.tree.forward(&factor, columns, &an.schedule, self.par)
+        an.tree
+            .forward(&factor_view(an, f), columns, &an.schedule, self.par)
     }
 }
