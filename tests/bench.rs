@@ -48,6 +48,13 @@ fn the_small_cell_runs_every_stage() {
     let one = &c.reuse[0];
     assert_eq!(one.switched, 1);
     assert!(one.converged && one.iterations >= 1, "{one:?}");
+    // The ratios divide by the reported steady-state refactorization.
+    let refactor = one.refactorization_seconds.expect("faer's refactorization");
+    assert!(refactor > 0.0);
+    assert!((one.ratio_to_refactorization * refactor - one.seconds).abs() <= 1e-9 * one.seconds);
+    let [first, _] = one.low_rank_ratios.expect("low-rank ratios");
+    let low_rank = one.low_rank_seconds.expect("low-rank seconds");
+    assert!((first * refactor - low_rank).abs() <= 1e-9 * low_rank);
     let curve = c.curve.as_ref().expect("curve ran");
     assert_eq!(curve.error, None);
     assert!(curve.factorizations >= 1);

@@ -88,15 +88,24 @@ pub struct ReuseBench {
     pub converged: bool,
     /// Seconds of the preconditioned CG solve.
     pub seconds: f64,
-    /// Its cost relative to a numeric factorization plus solve.
+    /// Its cost relative to faer's refactorization plus solve (`refactorization_seconds`).
     pub ratio_to_refactorization: f64,
+    /// The denominator of the faer ratios: a numeric refactorization plus one solve on the
+    /// same solver, the median of at least three after a first (s). Absent in reports written
+    /// before, whose ratios divided by the first factorization of a fresh solver.
+    #[serde(default)]
+    pub refactorization_seconds: Option<f64>,
+    /// The same for CHOLMOD, the denominator of its ratios (s). Absent without the cholmod
+    /// feature.
+    #[serde(default)]
+    pub cholmod_refactorization_seconds: Option<f64>,
     /// CHOLMOD's downdate of its factor by the switched contacts' stick springs (rank 2k,
     /// [`PeriodicSystem::stick_spring_columns`]) plus one solve (s), the first after a
     /// factorization: it includes copying the supernodal factor into a simplicial LDLᵀ. Absent
     /// without the cholmod feature.
     #[serde(default)]
     pub updown_seconds: Option<f64>,
-    /// That relative to CHOLMOD's own numeric factorization plus solve.
+    /// That relative to CHOLMOD's refactorization plus solve.
     #[serde(default)]
     pub updown_ratio: Option<f64>,
     /// Normwise backward error of that solve on the switched matrix (the larger with the
@@ -107,7 +116,7 @@ pub struct ReuseBench {
     /// plus one solve (s): the cost once the factor is simplicial.
     #[serde(default)]
     pub updown_next_seconds: Option<f64>,
-    /// That relative to CHOLMOD's numeric factorization plus solve.
+    /// That relative to CHOLMOD's refactorization plus solve.
     #[serde(default)]
     pub updown_next_ratio: Option<f64>,
     /// The low-rank (Woodbury) solve on faer's factor of the unswitched matrix, as the
@@ -122,28 +131,47 @@ pub struct ReuseBench {
     /// Normwise backward error of the first low-rank solve on the switched matrix.
     #[serde(default)]
     pub low_rank_backward_error: Option<f64>,
-    /// The first and the next low-rank solve relative to faer's numeric factorization plus
-    /// solve.
+    /// The first and the next low-rank solve relative to faer's refactorization plus solve.
     #[serde(default)]
     pub low_rank_ratios: Option<[f64; 2]>,
 }
 
-/// A factorized solver and the seconds of its numeric factorization plus one solve.
+/// A factorized solver and the seconds of a refactorization plus one solve on it.
 type TimedSolver = (Box<dyn fibercell_solver::LinearSolver>, f64);
 
-/// CHOLMOD (when built with it) factorized on the unswitched matrix `a0`.
-fn updown_solver(a0: CscRef<'_>, rhs: &[f64]) -> Result<Option<TimedSolver>, Error> {
+/// Seconds of a numeric refactorization of `a` plus one solve of `rhs` on `solver`, which has
+/// factorized once: the median of `repeats` (at least three), as the stick/slip loop
+/// refactorizes on the same solver.
+fn refactorization(
+    solver: &mut dyn fibercell_solver::LinearSolver,
+    a: CscRef<'_>,
+    rhs: &[f64],
+    repeats: usize,
+) -> Result<f64, Error> {
+    let (seconds, _) = median_of(repeats.max(3), || {
+        solver.factorize(a)?;
+        let mut x = rhs.to_vec();
+        Ok(solver.solve_in_place(&mut x, 1)?)
+    })?;
+    Ok(seconds)
+}
+
+/// CHOLMOD (when built with it) factorized on the unswitched matrix `a0`, with its
+/// [`refactorization`] time.
+fn updown_solver(
+    a0: CscRef<'_>,
+    rhs: &[f64],
+    repeats: usize,
+) -> Result<Option<TimedSolver>, Error> {
     let mut solver = match make_solver(SolverKind::Cholmod, &Ordering::Auto, Vec::new()) {
         Ok(s) => s,
         Err(Error::Solver(fibercell_solver::SolverError::Unavailable { .. })) => return Ok(None),
         Err(e) => return Err(e),
     };
     solver.analyze(a0)?;
-    let t = Instant::now();
     solver.factorize(a0)?;
-    let mut x = rhs.to_vec();
-    solver.solve_in_place(&mut x, 1)?;
-    Ok(Some((solver, t.elapsed().as_secs_f64())))
+    let seconds = refactorization(solver.as_mut(), a0, rhs, repeats)?;
+    Ok(Some((solver, seconds)))
 }
 
 /// The incremental elasto-plastic curve.
@@ -361,28 +389,29 @@ fn low_rank_switch(
     Ok((first, t.elapsed().as_secs_f64(), error))
 }
 
-/// Solves after switching k contacts, for k at the given fractions of the contacts; CG stops
-/// once it has spent about two refactorizations.
+/// Solves after switching k contacts, for k at the given fractions of the contacts, against
+/// a [`refactorization`] (`repeats` of them); CG stops once it has spent about two
+/// refactorizations.
 fn bench_reuse(
     sys: &PeriodicSystem,
     model: &Model,
     rhs: &[f64],
     fractions: &[f64],
+    repeats: usize,
 ) -> Result<Vec<ReuseBench>, Error> {
     let base = sys.assemble(model);
     let a0 = sys.pattern.matrix(&base.values)?;
     let mut factor = make_solver(SolverKind::FaerCholesky, &Ordering::Auto, Vec::new())?;
     factor.analyze(a0)?;
-    let t = Instant::now();
     factor.factorize(a0)?;
     let t_solve = Instant::now();
     let mut x = rhs.to_vec();
     factor.solve_in_place(&mut x, 1)?;
     let solve = t_solve.elapsed().as_secs_f64();
-    let refactor = t.elapsed().as_secs_f64();
+    let refactor = refactorization(factor.as_mut(), a0, rhs, repeats)?;
     // Past twice a refactorization's time the crossover is behind: stop CG there.
     let max_iterations = ((2.0 * refactor / solve.max(1e-9)).ceil() as usize).clamp(10, 500);
-    let mut updown = updown_solver(a0, rhs)?;
+    let mut updown = updown_solver(a0, rhs, repeats)?;
     let n_contacts = sys.n_contacts();
     let mut out = Vec::new();
     for &fraction in fractions {
@@ -431,6 +460,8 @@ fn bench_reuse(
             converged: r.converged,
             seconds,
             ratio_to_refactorization: seconds / refactor,
+            refactorization_seconds: Some(refactor),
+            cholmod_refactorization_seconds: updown.as_ref().map(|u| u.1),
             updown_seconds: measured.map(|m| m.0),
             updown_ratio: measured.map(|m| m.0 / cholmod_refactor),
             updown_backward_error: measured.map(|m| m.1),
@@ -578,7 +609,13 @@ pub fn bench_cell(
         )?);
     }
     log(&format!("{cell}: solves after contact switches"));
-    let reuse = bench_reuse(&sys, &model, &rhs, &[0.001, 0.003, 0.01, 0.03])?;
+    let reuse = bench_reuse(
+        &sys,
+        &model,
+        &rhs,
+        &[0.001, 0.003, 0.01, 0.03],
+        opts.repeats,
+    )?;
     log(&format!("{cell}: six cell problems"));
     let (six, homogenized) = median_of(opts.repeats, || {
         homogenize_elastic(&model, &SolveOptions::default())

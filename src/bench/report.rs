@@ -179,23 +179,29 @@ pub fn markdown(r: &BenchReport) -> String {
     let _ = writeln!(s);
     let _ = writeln!(
         s,
-        "| cell | contacts switched | fraction | CG on the old factor: iterations | seconds | \
+        "| cell | contacts switched | fraction | refactorization + solve, faer / CHOLMOD | \
+         CG on the old factor: iterations | seconds | \
          of a refactorization | low-rank on faer's factor, first / next | of a refactorization \
          (first / next) | backward error | CHOLMOD downdate + solve, first | next | of CHOLMOD's \
          refactorization (first / next) | backward error |"
     );
     let _ = writeln!(
         s,
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for c in &r.cells {
         for u in &c.reuse {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.1} % | {}{} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {:.1} % | {} | {}{} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
                 c.cell,
                 u.switched,
                 100.0 * u.fraction,
+                match (u.refactorization_seconds, u.cholmod_refactorization_seconds) {
+                    (Some(a), Some(b)) => format!("{} / {}", ms(a), ms(b)),
+                    (Some(a), None) => ms(a),
+                    _ => "–".into(),
+                },
                 u.iterations,
                 if u.converged { "" } else { " (not converged)" },
                 ms(u.seconds),
