@@ -13,7 +13,7 @@ mod common;
 use common::small_nonwoven;
 use fibercell::homogenize::{elasto_plastic_curve, Curve, CurveOptions};
 use fibercell::model::FrictionSpec;
-use fibercell::solve::{IncrementalOptions, SolveOptions};
+use fibercell::solve::IncrementalOptions;
 use fibercell::Model;
 
 fn curve(reuse_factor: bool) -> Curve {
@@ -22,6 +22,20 @@ fn curve(reuse_factor: bool) -> Curve {
 
 /// The curve with the backward-error bar `max_backward_error` (0: the default 1e-10).
 fn curve_with(reuse_factor: bool, max_backward_error: f64) -> Curve {
+    curve_tuned(|o| {
+        o.reuse_factor = reuse_factor;
+        o.solve.max_backward_error = max_backward_error;
+    })
+}
+
+/// The curve with the options `tune` sets on the bonded, stabilized defaults.
+fn curve_tuned(tune: impl FnOnce(&mut IncrementalOptions)) -> Curve {
+    let mut incremental = IncrementalOptions {
+        bonded: true,
+        stabilization: 1e-8,
+        ..IncrementalOptions::default()
+    };
+    tune(&mut incremental);
     let mut desc = small_nonwoven();
     desc.contact.as_mut().unwrap().friction = FrictionSpec::Tresca { bound: 3e-6 };
     let model = Model::from_description(&desc).unwrap();
@@ -31,16 +45,7 @@ fn curve_with(reuse_factor: bool, max_backward_error: f64) -> Curve {
             strain: [2e-3, 0.0, 0.0, 0.0, 0.0, 0.0],
             steps: 20,
             unload: false,
-            incremental: IncrementalOptions {
-                bonded: true,
-                stabilization: 1e-8,
-                reuse_factor,
-                solve: SolveOptions {
-                    max_backward_error,
-                    ..SolveOptions::default()
-                },
-                ..IncrementalOptions::default()
-            },
+            incremental,
         },
     )
     .unwrap()
@@ -113,4 +118,45 @@ fn a_failed_residual_check_refactorizes_and_changes_nothing() {
         "no check failed: {factorizations} factorization"
     );
     assert_same_curve(&strict, &default);
+}
+
+/// Factorizations and low-rank solves over the whole curve.
+fn solves(c: &Curve) -> (usize, usize) {
+    c.solution.increments.iter().fold((0, 0), |(f, r), i| {
+        (f + i.factorizations, r + i.factor_reuses)
+    })
+}
+
+/// A store of at most 6 low-rank columns (three contacts' tangents) fills up within the first
+/// increments that slide: each time the matrix of the current states becomes the new reference
+/// and the columns start again. The curve is the default one to 1e-6 of the resultant scale,
+/// as in the reuse test above.
+#[test]
+fn a_full_store_of_low_rank_columns_refactorizes_and_changes_nothing() {
+    let default = curve(true);
+    let small = curve_tuned(|o| o.max_low_rank_columns = 6);
+    let (f0, _) = solves(&default);
+    let (f, r) = solves(&small);
+    assert!(
+        f > f0 && r > 0,
+        "{f} factorizations (default {f0}), {r} reuses"
+    );
+    assert_same_curve(&small, &default);
+}
+
+/// Capacitance matrices of order above 4 (more than two changed contacts) are not solved
+/// low-rank: those iterations factorize their matrix directly and the reference factorization
+/// stays for the iterations with fewer changes. The curve is the default one to 1e-6 of the
+/// resultant scale.
+#[test]
+fn capacitance_orders_above_the_bound_factorize_directly_and_change_nothing() {
+    let default = curve(true);
+    let bounded = curve_tuned(|o| o.max_capacitance_order = Some(4));
+    let (f0, _) = solves(&default);
+    let (f, r) = solves(&bounded);
+    assert!(
+        f > f0 && r > 0,
+        "{f} factorizations (default {f0}), {r} reuses"
+    );
+    assert_same_curve(&bounded, &default);
 }

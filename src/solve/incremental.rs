@@ -89,6 +89,16 @@ pub struct IncrementalOptions {
     /// refactorized and becomes the new reference (default true). Needs a direct symmetric
     /// backend; Coulomb sliding (a nonsymmetric E) is solved on the symmetric factorization.
     pub reuse_factor: bool,
+    /// Columns of the low-rank correction kept on one reference factorization; one more
+    /// refactorizes the current matrix as the new reference. S takes 8 bytes × this squared
+    /// (default [`MAX_LOW_RANK_COLUMNS`], 512 MB).
+    pub max_low_rank_columns: usize,
+    /// A state iteration whose capacitance matrix is larger than this factorizes its matrix
+    /// directly instead (the reference stays for the iterations after); `None` (default):
+    /// decided by the measured costs, a low-rank solve while its capacitance factorization is
+    /// predicted cheaper than a factorization. A bound makes the choice independent of the
+    /// machine's timings.
+    pub max_capacitance_order: Option<usize>,
     /// Stop after the increment during which this instant passes (default: none); the solution
     /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
     pub deadline: Option<std::time::Instant>,
@@ -106,6 +116,8 @@ impl Default for IncrementalOptions {
             stabilization: 0.0,
             bonded: false,
             reuse_factor: true,
+            max_low_rank_columns: MAX_LOW_RANK_COLUMNS,
+            max_capacitance_order: None,
             deadline: None,
         }
     }
@@ -400,9 +412,9 @@ fn stabilizer_force(pair: &ContactPair, state: ContactState, q: &BlockVector) ->
         })
 }
 
-/// Columns of the low-rank correction kept on one factorization before refactorizing: S, their
-/// dense products, then takes 8 bytes × this squared (512 MB).
-const MAX_LOW_RANK_COLUMNS: usize = 8192;
+/// Columns of the low-rank correction kept on one factorization before refactorizing, by
+/// default: S, their dense products, then takes 8 bytes × this squared (512 MB).
+pub const MAX_LOW_RANK_COLUMNS: usize = 8192;
 
 /// Correction steps x += W (b − A x) after a low-rank solve W ≈ A⁻¹ before it falls back to a
 /// factorization (the correction subtracts stick springs far stiffer than the fibers, which
@@ -1246,9 +1258,13 @@ pub(crate) fn run_incremental(
                 n_free > 0 && !refresh_reference,
             ) {
                 let (order, new) = low_rank.size_of(changes);
-                if low_rank.len() + new > MAX_LOW_RANK_COLUMNS {
+                let affordable = match opts.max_capacitance_order {
+                    Some(max) => order <= max,
+                    None => low_rank_cost.worth(order),
+                };
+                if low_rank.len() + new > opts.max_low_rank_columns {
                     refresh_reference = true;
-                } else if low_rank_cost.worth(order) {
+                } else if affordable {
                     low_rank
                         .extend(a0.as_mut(), changes, |c, k| {
                             low_rank_column(&pairs[c], disc, k)

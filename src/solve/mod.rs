@@ -14,7 +14,7 @@ pub use increment_timings::IncrementTimings;
 pub(crate) use incremental::run_incremental;
 pub use incremental::{
     solve_incremental, ContactRecord, IncrementRecord, IncrementalOptions, IncrementalSolution,
-    Progress,
+    Progress, MAX_LOW_RANK_COLUMNS,
 };
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
 pub use reduced::ReducedSystem;
