@@ -55,6 +55,10 @@ fn the_small_cell_runs_every_stage() {
     let [first, _] = one.low_rank_ratios.expect("low-rank ratios");
     let low_rank = one.low_rank_seconds.expect("low-rank seconds");
     assert!((first * refactor - low_rank).abs() <= 1e-9 * low_rank);
+    // Its stages (columns, capacitance, solve) make up the first low-rank solve.
+    let stages = one.low_rank_stages.expect("low-rank stages");
+    assert!(stages.iter().all(|&t| t >= 0.0), "{stages:?}");
+    assert!((stages.iter().sum::<f64>() - low_rank).abs() <= 1e-9 * low_rank);
     let curve = c.curve.as_ref().expect("curve ran");
     assert_eq!(curve.error, None);
     assert!(curve.factorizations >= 1);

@@ -128,6 +128,11 @@ pub struct ReuseBench {
     /// changed within them: the LU and one solve, from A₀⁻¹ b₀ known (s).
     #[serde(default)]
     pub low_rank_next_seconds: Option<f64>,
+    /// The first low-rank solve's stages (s): the new columns of S (sparse forward solves),
+    /// the capacitance factorization, and the solve (a forward and a backward half with A₀'s
+    /// factor, the products with W, the capacitance solve). Absent in reports written before.
+    #[serde(default)]
+    pub low_rank_stages: Option<[f64; 3]>,
     /// Normwise backward error of the first low-rank solve on the switched matrix.
     #[serde(default)]
     pub low_rank_backward_error: Option<f64>,
@@ -346,15 +351,15 @@ fn bench_backend(
 /// The contacts `list` switched stick → sliding as the low-rank correction A₀ − W Wᵀ (W their
 /// stick-spring columns, E = −I) of the factorization `a0` of the unswitched matrix: seconds of
 /// the first solve (columns, LU, two solves), of the next on the same columns with the load
-/// changed within them (LU, one solve), and the first's backward error on the switched matrix
-/// `a`.
+/// changed within them (LU, one solve), the first's stages (columns, capacitance, solve) and
+/// its backward error on the switched matrix `a`.
 fn low_rank_switch(
     sys: &PeriodicSystem,
     a0: &mut dyn fibercell_solver::LinearSolver,
     a: CscRef<'_>,
     rhs: &[f64],
     list: &[usize],
-) -> Result<(f64, f64, f64), Error> {
+) -> Result<LowRankSwitch, Error> {
     let w = sys.stick_spring_matrix(list)?;
     let w = w.as_ref();
     // Contact j owns the columns 2j, 2j + 1 of W, as basis rows 1 and 2 (the tangents).
@@ -375,9 +380,12 @@ fn low_rank_switch(
     let mut low_rank = LowRankCorrection::new(a.ncols(), list.len());
     let t = Instant::now();
     low_rank.extend(a0, &changes, column)?;
+    let columns = t.elapsed().as_secs_f64();
     let cap = low_rank.capacitance(&changes);
+    let capacitance = t.elapsed().as_secs_f64() - columns;
     let x = low_rank.solve(a0, &cap, rhs)?;
     let first = t.elapsed().as_secs_f64();
+    let stages = [columns, capacitance, first - columns - capacitance];
     let error = backward_error(a, &x, rhs);
     // The next solve as in a stick/slip iteration: the load changed within the switched
     // contacts' columns, solved from A₀⁻¹ b₀ of the increment (known) with one solve.
@@ -386,7 +394,20 @@ fn low_rank_switch(
     let t = Instant::now();
     let cap = low_rank.capacitance(&changes);
     low_rank.solve_from(a0, &cap, &x0, &load)?;
-    Ok((first, t.elapsed().as_secs_f64(), error))
+    Ok(LowRankSwitch {
+        first,
+        next: t.elapsed().as_secs_f64(),
+        stages,
+        error,
+    })
+}
+
+/// What [`low_rank_switch`] measured (s) and the first solve's backward error.
+struct LowRankSwitch {
+    first: f64,
+    next: f64,
+    stages: [f64; 3],
+    error: f64,
 }
 
 /// Solves after switching k contacts, for k at the given fractions of the contacts, against
@@ -467,10 +488,11 @@ fn bench_reuse(
             updown_backward_error: measured.map(|m| m.1),
             updown_next_seconds: measured.map(|m| m.2),
             updown_next_ratio: measured.map(|m| m.2 / cholmod_refactor),
-            low_rank_seconds: Some(low_rank.0),
-            low_rank_next_seconds: Some(low_rank.1),
-            low_rank_backward_error: Some(low_rank.2),
-            low_rank_ratios: Some([low_rank.0 / refactor, low_rank.1 / refactor]),
+            low_rank_seconds: Some(low_rank.first),
+            low_rank_next_seconds: Some(low_rank.next),
+            low_rank_stages: Some(low_rank.stages),
+            low_rank_backward_error: Some(low_rank.error),
+            low_rank_ratios: Some([low_rank.first / refactor, low_rank.next / refactor]),
         });
     }
     Ok(out)

@@ -181,19 +181,19 @@ pub fn markdown(r: &BenchReport) -> String {
         s,
         "| cell | contacts switched | fraction | refactorization + solve, faer / CHOLMOD | \
          CG on the old factor: iterations | seconds | \
-         of a refactorization | low-rank on faer's factor, first / next | of a refactorization \
-         (first / next) | backward error | CHOLMOD downdate + solve, first | next | of CHOLMOD's \
+         of a refactorization | low-rank on faer's factor, first / next | first: columns / \
+         capacitance / solve | of a refactorization (first / next) | backward error | CHOLMOD downdate + solve, first | next | of CHOLMOD's \
          refactorization (first / next) | backward error |"
     );
     let _ = writeln!(
         s,
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for c in &r.cells {
         for u in &c.reuse {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.1} % | {} | {}{} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {:.1} % | {} | {}{} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 c.cell,
                 u.switched,
                 100.0 * u.fraction,
@@ -210,6 +210,9 @@ pub fn markdown(r: &BenchReport) -> String {
                     (Some(a), Some(b)) => format!("{} / {}", ms(a), ms(b)),
                     _ => "–".into(),
                 },
+                opt(u
+                    .low_rank_stages
+                    .map(|[c, f, s]| format!("{} / {} / {}", ms(c), ms(f), ms(s)))),
                 opt(u.low_rank_ratios.map(|[a, b]| format!("{a:.2} / {b:.2}"))),
                 opt(u.low_rank_backward_error.map(|x| format!("{x:.1e}"))),
                 opt(u.updown_seconds.map(ms)),
