@@ -11,9 +11,9 @@
 
 mod common;
 use common::small_nonwoven;
-use fibercell::homogenize::{elasto_plastic_curve, Curve, CurveOptions};
+use fibercell::homogenize::{elastic_abd, elasto_plastic_curve, Curve, CurveOptions};
 use fibercell::model::FrictionSpec;
-use fibercell::solve::IncrementalOptions;
+use fibercell::solve::{IncrementalOptions, SolveOptions};
 use fibercell::Model;
 
 fn curve(reuse_factor: bool) -> Curve {
@@ -157,4 +157,65 @@ fn a_full_store_of_low_rank_columns_refactorizes_and_changes_nothing() {
 #[test]
 fn capacitance_orders_above_the_bound_factorize_directly_and_change_nothing() {
     refactorizes_more_and_changes_nothing(|o| o.max_capacitance_order = Some(4));
+}
+
+/// The curve's elastic ABD comes from six solves on the run's first factorization, the
+/// all-stick matrix of the incremental pattern: without stabilization that is K_ff of
+/// `elastic_abd`'s own system (the open contacts' slots hold zeros), so the two agree to
+/// rounding: 1e-8 of the largest entry (measured 4e-10; `elastic_abd` itself moves by 7e-10
+/// and 4e-9 of it from AMD to the natural and the nested-dissection orderings, the stick
+/// springs being far stiffer than the fibers); with ε springs on
+/// the open contacts it is K_ff + ε Σ K_open, whose Schur complement is stiffer, by a PSD
+/// matrix: every diagonal entry at least `elastic_abd`'s, and measurably larger at ε = 10⁻²
+/// (this is the path the run took). Without factor reuse there is no reference: the curve
+/// factorizes K_ff itself, exactly `elastic_abd`.
+#[test]
+fn the_elastic_abd_is_solved_on_the_runs_all_stick_factorization() {
+    let mut desc = small_nonwoven();
+    desc.contact.as_mut().unwrap().friction = FrictionSpec::Tresca { bound: 3e-6 };
+    let model = Model::from_description(&desc).unwrap();
+    let alone = elastic_abd(&model, &SolveOptions::default()).unwrap();
+    let scale = alone.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    let short = |tune: &dyn Fn(&mut IncrementalOptions)| {
+        let mut incremental = IncrementalOptions {
+            bonded: true,
+            ..IncrementalOptions::default()
+        };
+        tune(&mut incremental);
+        elasto_plastic_curve(
+            &model,
+            &CurveOptions {
+                strain: [2e-3, 0.0, 0.0, 0.0, 0.0, 0.0],
+                steps: 2,
+                unload: false,
+                incremental,
+            },
+        )
+        .unwrap()
+        .elastic_abd
+    };
+    let diff = |a: &[[f64; 6]; 6]| {
+        a.iter()
+            .flatten()
+            .zip(alone.iter().flatten())
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+    };
+    let plain = short(&|_| {});
+    assert!(diff(&plain) <= 1e-8 * scale, "{}", diff(&plain) / scale);
+    let own = short(&|o| o.reuse_factor = false);
+    assert_eq!(own, alone);
+    let stiffened = short(&|o| o.stabilization = 1e-2);
+    for i in 0..6 {
+        assert!(
+            stiffened[i][i] >= alone[i][i] - 1e-10 * scale,
+            "entry {i}: {} < {}",
+            stiffened[i][i],
+            alone[i][i]
+        );
+    }
+    assert!(
+        diff(&stiffened) > 1e-6 * scale,
+        "{}",
+        diff(&stiffened) / scale
+    );
 }

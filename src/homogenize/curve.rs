@@ -3,12 +3,13 @@
 //! strain, the strain at which each contact switches, the piecewise-linear segments (one per
 //! switch), the elastic/plastic split (5.5–5.6) and the dissipated energy.
 
-use super::elastic_abd;
+use super::elastic::{abd_on_factor, factorize_cell};
 use super::segments::{linear_pieces, segment_starting_at, Segment};
+use super::{HomogenizeTimings, PeriodicSystem};
 use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
 use crate::model::Model;
-use crate::solve::{run_incremental, IncrementalOptions, IncrementalSolution};
+use crate::solve::{run_incremental, IncrementalOptions, IncrementalSolution, OnAllStick};
 use crate::Error;
 use serde::Serialize;
 
@@ -71,7 +72,10 @@ pub struct SwitchEvent {
 /// The curve and everything derived from it.
 #[derive(Clone, Debug, Serialize)]
 pub struct Curve {
-    /// The all-stick elastic ABD used for the split.
+    /// The all-stick elastic ABD used for the split: six cell problems solved on the run's
+    /// first factorization when that is the all-stick matrix (with factor reuse, the default),
+    /// which then includes the open contacts' stabilizing springs ε (none by default);
+    /// otherwise on a factorization of its own, exactly [`super::elastic_abd`].
     pub elastic_abd: [[f64; 6]; 6],
     /// Points, one per increment.
     pub points: Vec<CurvePoint>,
@@ -96,7 +100,11 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             "the number of increments must be at least 1".into(),
         ));
     }
-    let elastic_abd = elastic_abd(model, &opts.incremental.solve)?;
+    // The all-stick system: its driver couplings K_fE and K_EE give the elastic ABD from six
+    // solves on the run's first factorization when that is the all-stick matrix (same free
+    // DOFs), else on a factorization of its own.
+    let sys = PeriodicSystem::new(model)?;
+    let vals = sys.assemble(model);
     let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, false)?;
     let disc = Discretization::periodic(model, &p, &opts.strain, anchor);
     let n = opts.steps;
@@ -110,7 +118,33 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
         path: Some(path),
         ..opts.incremental.clone()
     };
-    let sol = run_incremental(model, &disc, set, &inc)?;
+    let mut from_reference = None;
+    let mut on_all_stick = |solver: &mut dyn fibercell_solver::LinearSolver,
+                            a: fibercell_solver::CscRef<'_>| {
+        if a.nrows() == sys.n_free() {
+            from_reference = Some(abd_on_factor(
+                model,
+                &sys,
+                &vals,
+                solver,
+                a,
+                &opts.incremental.solve,
+            )?);
+        }
+        Ok(())
+    };
+    let hook: OnAllStick<'_> = &mut on_all_stick;
+    let sol = run_incremental(model, &disc, set, &inc, Some(hook))?;
+    let elastic_abd = match from_reference {
+        Some(abd) => abd,
+        None => {
+            let solve = &opts.incremental.solve;
+            let mut timings = HomogenizeTimings::default();
+            let mut solver = factorize_cell(model, &sys, &vals, solve, &mut timings)?;
+            let a = sys.pattern.matrix(&vals.values)?;
+            abd_on_factor(model, &sys, &vals, solver.as_mut(), a, solve)?
+        }
+    };
     let area = p.geometry.area();
     let mut points = Vec::with_capacity(sol.increments.len());
     for r in &sol.increments {

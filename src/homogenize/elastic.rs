@@ -10,7 +10,7 @@ use crate::cell::{macro_matrix, CellGeometry};
 use crate::model::Model;
 use crate::solve::{check_backward_error, make_solver, SolveOptions};
 use crate::Error;
-use fibercell_solver::{solve_checked, LinearSolver, SolverError};
+use fibercell_solver::{solve_checked, CscRef, LinearSolver, SolverError};
 use nalgebra::DMatrix;
 use serde::Serialize;
 
@@ -129,14 +129,29 @@ fn factor_cell(
     let sys = PeriodicSystem::new(model)?;
     timings.setup = lap();
     let vals = sys.assemble(model);
-    let a = sys.pattern.matrix(&vals.values)?;
     timings.assembly = lap();
+    let solver = factorize_cell(model, &sys, &vals, options, timings)?;
+    Ok((sys, vals, solver))
+}
+
+/// The cell matrix `vals` of `sys` analysed and factorized (stages timed into `timings`).
+pub(super) fn factorize_cell(
+    model: &Model,
+    sys: &PeriodicSystem,
+    vals: &PeriodicValues,
+    options: &SolveOptions,
+    timings: &mut HomogenizeTimings,
+) -> Result<Box<dyn LinearSolver>, Error> {
+    let mut clock = std::time::Instant::now();
+    let mut lap = || lap_seconds(&mut clock);
+    let a = sys.pattern.matrix(&vals.values)?;
+    timings.assembly += lap();
     let mut solver = make_solver(options.solver, &options.ordering, Vec::new())?;
     solver.analyze(a).map_err(|e| sys.locate(model, e))?;
     timings.analysis = lap();
     solver.factorize(a).map_err(|e| sys.locate(model, e))?;
     timings.factorization = lap();
-    Ok((sys, vals, solver))
+    Ok(solver)
 }
 
 /// ABD = (K_EE + K_Ef x) / |Y| from the driver couplings and the six cell-problem solutions
@@ -169,13 +184,27 @@ fn cell_rhs(vals: &PeriodicValues, n: usize, extra: usize) -> Vec<f64> {
 /// [`super::elasto_plastic_curve`] splits its resultants with).
 pub fn elastic_abd(model: &Model, options: &SolveOptions) -> Result<[[f64; 6]; 6], Error> {
     let (sys, vals, mut solver) = factor_cell(model, options, &mut HomogenizeTimings::default())?;
-    let n = sys.n_free();
     let a = sys.pattern.matrix(&vals.values)?;
-    let rhs = cell_rhs(&vals, n, 0);
-    let (x, report) =
-        solve_checked(solver.as_mut(), a, &rhs, 6).map_err(|e| sys.locate(model, e))?;
+    abd_on_factor(model, &sys, &vals, solver.as_mut(), a, options)
+}
+
+/// The all-stick ABD from the six cell problems −K_fE e_k of `vals` solved on `solver`, a
+/// factorization of `a`: K_ff itself, or any matrix on the same free DOFs that stands for it
+/// (the incremental run's reference, whose pattern also holds the open contacts). The
+/// backward error is checked against `a`.
+pub(super) fn abd_on_factor(
+    model: &Model,
+    sys: &PeriodicSystem,
+    vals: &PeriodicValues,
+    solver: &mut dyn LinearSolver,
+    a: CscRef<'_>,
+    options: &SolveOptions,
+) -> Result<[[f64; 6]; 6], Error> {
+    let n = sys.n_free();
+    let rhs = cell_rhs(vals, n, 0);
+    let (x, report) = solve_checked(solver, a, &rhs, 6).map_err(|e| sys.locate(model, e))?;
     check_backward_error(options, report.backward_error, "cell problems")?;
-    Ok(abd_of(&vals, &x, n, sys.periodicity.geometry.area()))
+    Ok(abd_of(vals, &x, n, sys.periodicity.geometry.area()))
 }
 
 /// Solves the six unit cell problems of `model` (which needs a `[cell]`) and returns ABD and

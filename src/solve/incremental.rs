@@ -594,8 +594,15 @@ pub fn solve_incremental(
     opts: &IncrementalOptions,
 ) -> Result<IncrementalSolution, Error> {
     let set = ContactSet::build(model)?;
-    run_incremental(model, &Discretization::supported(model), set, opts)
+    run_incremental(model, &Discretization::supported(model), set, opts, None)
 }
+
+/// Called once with the run's first reference factorization when that is the all-stick matrix
+/// (every closed contact in stick, every other open; open contacts carry their stabilizing
+/// springs when [`IncrementalOptions::stabilization`] > 0): the factorized solver and the
+/// matrix. The elasto-plastic curve solves its six elastic cell problems on it.
+pub(crate) type OnAllStick<'h> =
+    &'h mut dyn FnMut(&mut dyn LinearSolver, CscRef<'_>) -> Result<(), Error>;
 
 /// The elastic part on a discretization: element blocks on generalized nodes.
 struct Elastic {
@@ -815,6 +822,7 @@ pub(crate) fn run_incremental(
     disc: &Discretization,
     set: ContactSet,
     opts: &IncrementalOptions,
+    mut on_all_stick: Option<OnAllStick<'_>>,
 ) -> Result<IncrementalSolution, Error> {
     let path: Vec<f64> = match &opts.path {
         Some(p) => p.clone(),
@@ -856,6 +864,7 @@ pub(crate) fn run_incremental(
                     deadline: None,
                     ..opts.clone()
                 },
+                None,
             )?;
             let last = pre.contact_results.last().cloned().unwrap_or_default();
             set.pairs
@@ -1379,6 +1388,16 @@ pub(crate) fn run_incremental(
                         reference_values.copy_from_slice(&values);
                         changed_since_reference = Some(Vec::new());
                         low_rank.reset();
+                        let all_stick = states.iter().zip(&pairs).all(|(s, p)| {
+                            *s == if p.gap <= 0.0 {
+                                ContactState::Stick
+                            } else {
+                                ContactState::Open
+                            }
+                        });
+                        if let Some(hook) = on_all_stick.take().filter(|_| all_stick) {
+                            hook(solver.as_mut(), a)?;
+                        }
                     }
                     lap(&mut timings.factorize, &mut clock);
                 }

@@ -11,7 +11,7 @@ mod static_solve;
 pub use backend::{make_solver, SolverKind};
 pub use connectivity::{check_supported, check_supported_with};
 pub use increment_timings::IncrementTimings;
-pub(crate) use incremental::run_incremental;
+pub(crate) use incremental::{run_incremental, OnAllStick};
 pub use incremental::{
     solve_incremental, ContactRecord, IncrementRecord, IncrementalOptions, IncrementalSolution,
     Progress, MAX_LOW_RANK_COLUMNS,
