@@ -3,9 +3,9 @@
 //! strain, the strain at which each contact switches, the piecewise-linear segments (one per
 //! switch), the elastic/plastic split (5.5–5.6) and the dissipated energy.
 
-use super::elastic::{abd_on_factor, factorize_cell};
+use super::elastic::abd_on_factor;
 use super::segments::{linear_pieces, segment_starting_at, Segment};
-use super::{HomogenizeTimings, PeriodicSystem};
+use super::{elastic_abd, PeriodicSystem};
 use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
 use crate::model::Model;
@@ -100,11 +100,15 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             "the number of increments must be at least 1".into(),
         ));
     }
-    // The all-stick system: its driver couplings K_fE and K_EE give the elastic ABD from six
-    // solves on the run's first factorization when that is the all-stick matrix (same free
-    // DOFs), else on a factorization of its own.
-    let sys = PeriodicSystem::new(model)?;
-    let vals = sys.assemble(model);
+    // The all-stick system's driver couplings K_fE and K_EE: with six solves on the run's first
+    // factorization, when that is the all-stick matrix (same free DOFs), they give the elastic
+    // ABD. K_ff's own values and pattern are not kept through the run.
+    let couplings = {
+        let sys = PeriodicSystem::new(model)?;
+        let mut vals = sys.assemble(model);
+        vals.values = Vec::new();
+        vals
+    };
     let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, false)?;
     let disc = Discretization::periodic(model, &p, &opts.strain, anchor);
     let n = opts.steps;
@@ -118,18 +122,15 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
         path: Some(path),
         ..opts.incremental.clone()
     };
+    let area = p.geometry.area();
     let mut from_reference = None;
+    let n_free = disc.n_free();
+    let locate = |e| crate::solve::locate(e, model, &|c| (c < n_free).then(|| disc.node_dof(c)));
     let mut on_all_stick = |solver: &mut dyn fibercell_solver::LinearSolver,
                             a: fibercell_solver::CscRef<'_>| {
-        if a.nrows() == sys.n_free() {
-            from_reference = Some(abd_on_factor(
-                model,
-                &sys,
-                &vals,
-                solver,
-                a,
-                &opts.incremental.solve,
-            )?);
+        if a.nrows() == couplings.coupling.len() {
+            let solve = &opts.incremental.solve;
+            from_reference = Some(abd_on_factor(&couplings, area, solver, a, solve, &locate)?);
         }
         Ok(())
     };
@@ -137,15 +138,8 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
     let sol = run_incremental(model, &disc, set, &inc, Some(hook))?;
     let elastic_abd = match from_reference {
         Some(abd) => abd,
-        None => {
-            let solve = &opts.incremental.solve;
-            let mut timings = HomogenizeTimings::default();
-            let mut solver = factorize_cell(model, &sys, &vals, solve, &mut timings)?;
-            let a = sys.pattern.matrix(&vals.values)?;
-            abd_on_factor(model, &sys, &vals, solver.as_mut(), a, solve)?
-        }
+        None => elastic_abd(model, &opts.incremental.solve)?,
     };
-    let area = p.geometry.area();
     let mut points = Vec::with_capacity(sol.increments.len());
     for r in &sol.increments {
         let strain = opts.strain.map(|e| r.alpha * e);

@@ -129,29 +129,14 @@ fn factor_cell(
     let sys = PeriodicSystem::new(model)?;
     timings.setup = lap();
     let vals = sys.assemble(model);
-    timings.assembly = lap();
-    let solver = factorize_cell(model, &sys, &vals, options, timings)?;
-    Ok((sys, vals, solver))
-}
-
-/// The cell matrix `vals` of `sys` analysed and factorized (stages timed into `timings`).
-pub(super) fn factorize_cell(
-    model: &Model,
-    sys: &PeriodicSystem,
-    vals: &PeriodicValues,
-    options: &SolveOptions,
-    timings: &mut HomogenizeTimings,
-) -> Result<Box<dyn LinearSolver>, Error> {
-    let mut clock = std::time::Instant::now();
-    let mut lap = || lap_seconds(&mut clock);
     let a = sys.pattern.matrix(&vals.values)?;
-    timings.assembly += lap();
+    timings.assembly = lap();
     let mut solver = make_solver(options.solver, &options.ordering, Vec::new())?;
     solver.analyze(a).map_err(|e| sys.locate(model, e))?;
     timings.analysis = lap();
     solver.factorize(a).map_err(|e| sys.locate(model, e))?;
     timings.factorization = lap();
-    Ok(solver)
+    Ok((sys, vals, solver))
 }
 
 /// ABD = (K_EE + K_Ef x) / |Y| from the driver couplings and the six cell-problem solutions
@@ -185,26 +170,29 @@ fn cell_rhs(vals: &PeriodicValues, n: usize, extra: usize) -> Vec<f64> {
 pub fn elastic_abd(model: &Model, options: &SolveOptions) -> Result<[[f64; 6]; 6], Error> {
     let (sys, vals, mut solver) = factor_cell(model, options, &mut HomogenizeTimings::default())?;
     let a = sys.pattern.matrix(&vals.values)?;
-    abd_on_factor(model, &sys, &vals, solver.as_mut(), a, options)
+    let area = sys.periodicity.geometry.area();
+    abd_on_factor(&vals, area, solver.as_mut(), a, options, &|e| {
+        sys.locate(model, e)
+    })
 }
 
-/// The all-stick ABD from the six cell problems −K_fE e_k of `vals` solved on `solver`, a
-/// factorization of `a`: K_ff itself, or any matrix on the same free DOFs that stands for it
-/// (the incremental run's reference, whose pattern also holds the open contacts). The
-/// backward error is checked against `a`.
+/// The all-stick ABD from the six cell problems −K_fE e_k of `vals` (its couplings K_fE and
+/// K_EE; K_ff's values are not read) solved on `solver`, a factorization of `a`: K_ff itself,
+/// or a matrix on the same free DOFs that stands for it (the incremental run's reference, whose
+/// pattern also holds the open contacts). The backward error is checked against `a`.
 pub(super) fn abd_on_factor(
-    model: &Model,
-    sys: &PeriodicSystem,
     vals: &PeriodicValues,
+    area: f64,
     solver: &mut dyn LinearSolver,
     a: CscRef<'_>,
     options: &SolveOptions,
+    locate: &dyn Fn(SolverError) -> Error,
 ) -> Result<[[f64; 6]; 6], Error> {
-    let n = sys.n_free();
+    let n = vals.coupling.len();
     let rhs = cell_rhs(vals, n, 0);
-    let (x, report) = solve_checked(solver, a, &rhs, 6).map_err(|e| sys.locate(model, e))?;
+    let (x, report) = solve_checked(solver, a, &rhs, 6).map_err(locate)?;
     check_backward_error(options, report.backward_error, "cell problems")?;
-    Ok(abd_of(vals, &x, n, sys.periodicity.geometry.area()))
+    Ok(abd_of(vals, &x, n, area))
 }
 
 /// Solves the six unit cell problems of `model` (which needs a `[cell]`) and returns ABD and
