@@ -128,6 +128,12 @@ impl Discretization {
     pub fn prescribed_value(&self, g: usize) -> f64 {
         self.prescribed[g]
     }
+    /// A solver error with its column mapped to node, DOF and fibers of `model` where it names
+    /// one (an unknown of a physical node).
+    pub(crate) fn locate(&self, model: &Model, e: fibercell_solver::SolverError) -> crate::Error {
+        let n = self.n_free();
+        crate::solve::locate(e, model, &|c: usize| (c < n).then(|| self.node_dof(c)))
+    }
     /// (generalized node, DOF) of an unknown; the node is physical unless it is the driver.
     pub fn node_dof(&self, k: usize) -> (usize, Dof) {
         self.free[k]

@@ -124,8 +124,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
     };
     let area = p.geometry.area();
     let mut from_reference = None;
-    let n_free = disc.n_free();
-    let locate = |e| crate::solve::locate(e, model, &|c| (c < n_free).then(|| disc.node_dof(c)));
+    let locate = |e| disc.locate(model, e);
     let mut on_all_stick = |solver: &mut dyn fibercell_solver::LinearSolver,
                             a: fibercell_solver::CscRef<'_>| {
         if a.nrows() == couplings.coupling.len() {

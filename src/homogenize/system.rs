@@ -257,8 +257,7 @@ impl PeriodicSystem {
     /// A solver error with its column mapped to node, DOF and fibers of `model` where it
     /// names one.
     pub(crate) fn locate(&self, model: &Model, e: SolverError) -> Error {
-        let n = self.n_free();
-        crate::solve::locate(e, model, &|c: usize| (c < n).then(|| self.node_dof(c)))
+        self.discretization.locate(model, e)
     }
 
     /// Number of closed contacts included as stick springs.

@@ -18,7 +18,7 @@
 //! to the chosen symmetric backend.
 
 use super::low_rank::{Capacitance, ContactChange, LowRankCorrection, Reference, SparseColumn};
-use super::static_solve::{backward_tolerance, check_backward_error, locate};
+use super::static_solve::{backward_tolerance, check_backward_error};
 use super::{check_supported_with, make_solver, IncrementTimings, SolveOptions, SolverKind};
 use crate::assembly::{
     color_blocks, element_stiffness, Assembler, DofMap, Pattern, SharedMut, NO_SLOT,
@@ -920,8 +920,7 @@ pub(crate) fn run_incremental(
     // Set when the correction outgrew its columns or missed its accuracy: the next symmetric
     // factorization becomes the new reference.
     let mut refresh_reference = false;
-    let node_dof = |c: usize| (c < n_free).then(|| disc.node_dof(c));
-    let locate = |e: SolverError| locate(e, model, &node_dof);
+    let locate = |e: SolverError| disc.locate(model, e);
 
     // Contact states: closed pairs start in stick (thesis step 1), others open.
     let initial = |p: &ContactPair| {
@@ -1388,15 +1387,13 @@ pub(crate) fn run_incremental(
                         reference_values.copy_from_slice(&values);
                         changed_since_reference = Some(Vec::new());
                         low_rank.reset();
-                        let all_stick = states.iter().zip(&pairs).all(|(s, p)| {
-                            *s == if p.gap <= 0.0 {
-                                ContactState::Stick
-                            } else {
-                                ContactState::Open
+                        // The initial states are all-stick unless frictionless (sliding).
+                        if let Some(hook) = on_all_stick.take() {
+                            if friction != Friction::None
+                                && states.iter().zip(&pairs).all(|(s, p)| *s == initial(p))
+                            {
+                                hook(solver.as_mut(), a)?;
                             }
-                        });
-                        if let Some(hook) = on_all_stick.take().filter(|_| all_stick) {
-                            hook(solver.as_mut(), a)?;
                         }
                     }
                     lap(&mut timings.factorize, &mut clock);
