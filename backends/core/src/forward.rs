@@ -23,7 +23,8 @@ pub struct ForwardBlock {
     pub first_row: usize,
     /// Its rows (columns of L).
     pub rows: usize,
-    /// The columns of B that reach it, ascending.
+    /// The columns of B that reach it, in the order of `values`: ascending, or grouped by the
+    /// first row they can be nonzero in where a backend skips leading zero rows.
     pub columns: Vec<usize>,
     /// `rows × columns.len()` values, column-major.
     pub values: Vec<f64>,

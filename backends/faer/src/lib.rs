@@ -4,6 +4,7 @@
 
 mod block_solve;
 mod cholesky;
+mod column_layout;
 mod lu;
 mod pivots;
 mod sparse_forward;

@@ -2,8 +2,10 @@
 //! elimination-tree paths of the nonzeros (Gilbert–Peierls reach, by blocks of L).
 
 use crate::block_solve::SolveSchedule;
+use crate::column_layout::ColumnLayout;
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::{Accum, MatMut, MatRef, Par};
 use fibercell_solver::{ForwardBlock, ForwardColumns, SolverError};
@@ -180,6 +182,7 @@ impl BlockTree {
         for (k, &s) in touched.iter().enumerate() {
             slot[s] = k;
         }
+        let layouts = self.column_layouts(symbolic, columns, inv, &touched, &members, &slot);
         let x_len: Vec<usize> = touched
             .iter()
             .map(|&s| self.shapes[s].width * members[s].len())
@@ -191,6 +194,7 @@ impl BlockTree {
                 let s = self.block_of[p];
                 let b = self.block(symbolic, values, s);
                 let c = members[s].binary_search(&j).unwrap_or(0);
+                let c = layouts[slot[s]].as_ref().map_or(c, |l| l.position[c]);
                 x[slot[s]][c * b.width + p - b.begin] += v * scale[i];
             }
         }
@@ -227,19 +231,27 @@ impl BlockTree {
             slot: &slot,
             group_of: &group_of,
             index: &index,
+            layouts: &layouts,
             par,
         };
         let (tasks, top_group) = groups.split_at_mut(top);
-        let copies: Vec<Vec<Vec<f64>>> = tasks
+        let top_xs = &mut top_group[0];
+        // The first task adds to the top blocks themselves, the others to private copies.
+        let mut copies: Vec<Vec<Vec<f64>>> = vec![Vec::new(); top.saturating_sub(1)];
+        let mut targets: Vec<&mut Vec<Vec<f64>>> = Vec::with_capacity(top);
+        targets.push(top_xs);
+        targets.extend(copies.iter_mut());
+        tasks
             .par_iter_mut()
             .zip(&lists[..top])
+            .zip(targets)
             .enumerate()
-            .map(|(g, (mine, list))| {
-                let mut copy: Vec<Vec<f64>> = top_sizes.iter().map(|&n| vec![0.0; n]).collect();
-                walk.eliminate(g, list, mine, Some(&mut copy));
-                copy
-            })
-            .collect();
+            .for_each(|(g, ((mine, list), target))| {
+                if g > 0 {
+                    *target = top_sizes.iter().map(|&n| vec![0.0; n]).collect();
+                }
+                walk.eliminate(g, list, mine, Some(target));
+            });
         let top_xs = &mut top_group[0];
         for copy in copies {
             for (xt, c) in top_xs.iter_mut().zip(copy) {
@@ -255,11 +267,15 @@ impl BlockTree {
         let blocks = touched
             .iter()
             .zip(x)
-            .map(|(&s, values_s)| ForwardBlock {
+            .zip(&layouts)
+            .map(|((&s, values_s), layout)| ForwardBlock {
                 block: s,
                 first_row: self.shapes[s].begin,
                 rows: self.shapes[s].width,
-                columns: std::mem::take(&mut members[s]),
+                columns: match layout {
+                    Some(l) => l.order.iter().map(|&c| members[s][c]).collect(),
+                    None => std::mem::take(&mut members[s]),
+                },
                 values: values_s,
             })
             .collect();
@@ -267,6 +283,69 @@ impl BlockTree {
             ncols: columns.len(),
             blocks,
         })
+    }
+
+    /// Per touched block (`touched`, with `slot` its inverse): the storage order of its
+    /// columns by the first row each can be nonzero in — the least of its own entries' rows
+    /// and its touched children's first pattern rows (a descendant's pattern rows in a block
+    /// are among those of the child it lies under) — where that saves flops.
+    fn column_layouts(
+        &self,
+        symbolic: &SymbolicCholesky<usize>,
+        columns: &[Vec<(usize, f64)>],
+        inv: &[usize],
+        touched: &[usize],
+        members: &[Vec<usize>],
+        slot: &[usize],
+    ) -> Vec<Option<ColumnLayout>> {
+        let mut first: Vec<Vec<usize>> = touched
+            .iter()
+            .map(|&s| {
+                let (width, m) = (self.shapes[s].width, members[s].len());
+                if ColumnLayout::may_pay(width, m) {
+                    vec![width; m]
+                } else {
+                    Vec::new()
+                }
+            })
+            .collect();
+        for (j, col) in columns.iter().enumerate() {
+            for &(i, _) in col {
+                let p = inv[i];
+                let s = self.block_of[p];
+                let f = &mut first[slot[s]];
+                if let (false, Ok(c)) = (f.is_empty(), members[s].binary_search(&j)) {
+                    f[c] = f[c].min(p - self.shapes[s].begin);
+                }
+            }
+        }
+        let rows = row_idx(symbolic);
+        for &c in touched {
+            let s = self.parent[c];
+            if s == NONE || first[slot[s]].is_empty() {
+                continue;
+            }
+            // The child's first pattern row lies in its parent.
+            let r = rows[self.shapes[c].pattern.start] - self.shapes[s].begin;
+            let f = &mut first[slot[s]];
+            let mut at = 0;
+            for &j in &members[c] {
+                while members[s][at] != j {
+                    at += 1;
+                }
+                f[at] = f[at].min(r);
+            }
+        }
+        touched
+            .iter()
+            .zip(first)
+            .map(|(&s, f)| {
+                let b = &self.shapes[s];
+                (!f.is_empty())
+                    .then(|| ColumnLayout::by_first_rows(&f, b.width, b.pattern.len()))
+                    .flatten()
+            })
+            .collect()
     }
 }
 
@@ -285,6 +364,8 @@ struct Walk<'a> {
     group_of: &'a [usize],
     /// Per touched block: its position in its group.
     index: &'a [usize],
+    /// Per touched block: the order of its stored columns when not ascending.
+    layouts: &'a [Option<ColumnLayout>],
     par: Par,
 }
 
@@ -319,56 +400,88 @@ impl Walk<'_> {
                 Par::Rayon(t) if rows * b.width * m > PARALLEL_FLOPS => t.get().min(m),
                 _ => 1,
             };
-            let chunk = m.div_ceil(threads.max(1)).max(1);
-            let solve = |x: &mut [f64], out: &mut [f64]| {
-                let k = x.len() / b.width;
+            let (w, p) = (b.width, b.pattern.len());
+            // Columns `x` vanishing above row `low`: the rows from `low` solved, `out` the
+            // product of the rows below with them.
+            let solve = |x: &mut [f64], out: &mut [f64], low: usize| {
+                let k = x.len() / w;
+                let mut x = MatMut::from_column_major_slice_mut(x, w, k).subrows_mut(low, w - low);
                 solve_lower_triangular_in_place(
-                    top,
-                    MatMut::from_column_major_slice_mut(x, b.width, k),
+                    top.submatrix(low, low, w - low, w - low),
+                    x.rb_mut(),
                     Par::Seq,
                 );
-                if !b.pattern.is_empty() {
+                if p > 0 {
                     matmul(
-                        MatMut::from_column_major_slice_mut(out, b.pattern.len(), k),
+                        MatMut::from_column_major_slice_mut(out, p, k),
                         Accum::Replace,
-                        bottom,
-                        MatRef::from_column_major_slice(x, b.width, k),
+                        bottom.subcols(low, w - low),
+                        x.rb(),
                         1.0,
                         Par::Seq,
                     );
                 }
             };
-            if threads > 1 {
-                let outs: Vec<&mut [f64]> = if b.pattern.is_empty() {
-                    (0..m.div_ceil(chunk)).map(|_| &mut [][..]).collect()
-                } else {
-                    below.chunks_mut(b.pattern.len() * chunk).collect()
-                };
-                xs.par_chunks_mut(b.width * chunk)
-                    .zip(outs)
-                    .for_each(|(x, out)| solve(x, out));
+            let layout = self.layouts[k].as_ref();
+            let one = [(0..m, 0)];
+            let groups = layout.map_or(&one[..], |l| &l.groups[..]);
+            // Work items: each group's columns in chunks (more than one chunk per thread when
+            // groups differ in cost, each chunk its own task).
+            let pieces = if groups.len() > 1 {
+                2 * threads
             } else {
-                solve(xs, &mut below);
+                threads
+            };
+            let mut items: Vec<(&mut [f64], &mut [f64], usize)> = Vec::new();
+            let (mut x_rest, mut out_rest) = (&mut xs[..], &mut below[..]);
+            for (range, low) in groups {
+                let chunk = range.len().div_ceil(pieces.max(1)).max(1);
+                let mut left = range.len();
+                while left > 0 {
+                    let c = chunk.min(left);
+                    let (x_now, x_next) = std::mem::take(&mut x_rest).split_at_mut(c * w);
+                    let (out_now, out_next) = std::mem::take(&mut out_rest).split_at_mut(c * p);
+                    items.push((x_now, out_now, *low));
+                    (x_rest, out_rest) = (x_next, out_next);
+                    left -= c;
+                }
+            }
+            if threads > 1 {
+                items
+                    .into_par_iter()
+                    .with_max_len(1)
+                    .for_each(|(x, out, low)| solve(x, out, low));
+            } else {
+                items
+                    .into_iter()
+                    .for_each(|(x, out, low)| solve(x, out, low));
             }
             if b.pattern.is_empty() {
                 continue;
             }
-            // Subtract from the ancestors' rows; this block's columns are among theirs.
-            let mut last = NONE;
-            for (r, &row) in b.pattern.iter().enumerate() {
-                let t = self.tree.block_of[row];
-                if t != last {
-                    last = t;
-                    position.clear();
-                    let mut at = 0;
-                    for &j in &self.members[s] {
-                        while self.members[t][at] != j {
-                            at += 1;
-                        }
-                        position.push(at);
-                    }
+            // Subtract from the ancestors' rows; this block's columns are among theirs. The
+            // pattern is ascending: a run of rows per ancestor, column by column (contiguous
+            // reads of `below`, ascending writes).
+            let mut r0 = 0;
+            while r0 < p {
+                let t = self.tree.block_of[b.pattern[r0]];
+                let mut r1 = r0 + 1;
+                while r1 < p && self.tree.block_of[b.pattern[r1]] == t {
+                    r1 += 1;
                 }
+                // Storage column of this block → storage column of the ancestor.
                 let kt = self.slot[t];
+                let ancestor = self.layouts[kt].as_ref();
+                position.clear();
+                position.resize(m, 0);
+                let mut at = 0;
+                for (c, &j) in self.members[s].iter().enumerate() {
+                    while self.members[t][at] != j {
+                        at += 1;
+                    }
+                    position[layout.map_or(c, |l| l.position[c])] =
+                        ancestor.map_or(at, |l| l.position[at]);
+                }
                 let xt = if self.group_of[kt] == group {
                     &mut rest[self.index[kt] - i - 1]
                 } else {
@@ -378,11 +491,15 @@ impl Walk<'_> {
                         None => unreachable!("an ancestor outside the top group"),
                     }
                 };
-                let bt = self.tree.block(self.symbolic, self.values, t);
-                let local = row - bt.begin;
+                let bt = &self.tree.shapes[t];
+                let rows = &b.pattern[r0..r1];
                 for (c, &at) in position.iter().enumerate() {
-                    xt[at * bt.width + local] -= below[c * b.pattern.len() + r];
+                    let out = &mut xt[at * bt.width..(at + 1) * bt.width];
+                    for (&row, v) in rows.iter().zip(&below[c * p + r0..c * p + r1]) {
+                        out[row - bt.begin] -= v;
+                    }
                 }
+                r0 = r1;
             }
         }
     }
@@ -611,6 +728,52 @@ pub(crate) mod tests {
         }
     }
 
+    /// Columns spread over a 20³ grid reach the top separators through children whose
+    /// patterns start at different rows: some blocks store them grouped by their first
+    /// possibly nonzero row and skip the zeros above. Every block's values still equal the
+    /// dense lower solve of each column (1e-12), sequential and split over 2 threads.
+    #[test]
+    fn forward_solve_with_columns_grouped_by_first_row_matches_dense_lower_solves() {
+        use crate::block_solve::SolveSchedule;
+        let (n, _, mut s) = grid_factor(20);
+        let b: Vec<Vec<(usize, f64)>> = (0..96)
+            .map(|j| vec![((j * 7919) % n, 1.0 + j as f64 / 7.0)])
+            .collect();
+        let lower: Vec<Vec<f64>> = b
+            .iter()
+            .map(|col| {
+                let mut dense = vec![0.0; n];
+                for &(i, v) in col {
+                    dense[i] = v;
+                }
+                s.solve_lower_in_place(&mut dense).unwrap();
+                dense
+            })
+            .collect();
+        let factor = s.factor_view();
+        let tree = BlockTree::of(factor.symbolic);
+        let schedule = SolveSchedule::with_threshold(&tree, 2, 0);
+        for par in [Par::Seq, Par::rayon(2)] {
+            let w = tree.forward(&factor, &b, &schedule, par).unwrap();
+            assert!(
+                w.blocks
+                    .iter()
+                    .any(|blk| blk.columns.windows(2).any(|p| p[0] > p[1])),
+                "no block grouped its columns"
+            );
+            for blk in &w.blocks {
+                for (c, &j) in blk.columns.iter().enumerate() {
+                    let want = &lower[j][blk.first_row..blk.first_row + blk.rows];
+                    let big = lower[j].iter().fold(1e-300f64, |m, v| m.max(v.abs()));
+                    let got = &blk.values[c * blk.rows..(c + 1) * blk.rows];
+                    for (g, r) in got.iter().zip(want) {
+                        assert!((g - r).abs() <= 1e-12 * big, "{par:?}: column {j}");
+                    }
+                }
+            }
+        }
+    }
+
     /// The half solves: the lower half of a dense column equals its sparse forward solve on
     /// the blocks it reaches and vanishes elsewhere; lower then upper is a solve (1e-12).
     #[test]
@@ -634,7 +797,7 @@ pub(crate) mod tests {
                 let big = dense.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
                 let mut seen = vec![false; n];
                 for blk in &w.blocks {
-                    if let Ok(c) = blk.columns.binary_search(&j) {
+                    if let Some(c) = blk.columns.iter().position(|&c| c == j) {
                         let got = &blk.values[c * blk.rows..(c + 1) * blk.rows];
                         for (r, g) in got.iter().enumerate() {
                             let want = dense[blk.first_row + r];
