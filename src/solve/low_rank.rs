@@ -12,6 +12,7 @@
 //! later solve on the same A₀, whatever its state or slip direction then. E may be
 //! nonsymmetric (Coulomb sliding) while A₀ is a symmetric factorization.
 
+use super::gram::new_gram_columns;
 use crate::contact::BlockCoefficients;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut, MatRef};
@@ -279,7 +280,8 @@ impl LowRankCorrection {
     }
 
     /// Adds S's entries for the columns `start..` from their forward solves `w`:
-    /// S = Wᵀ W block by block of L, each block's new columns against all its columns.
+    /// S = Wᵀ W block by block of L, each block's new columns against all its columns (the
+    /// blocks' products in parallel, the large ones split further).
     fn add_forward(&mut self, start: usize, w: ForwardColumns) {
         if matches!(self.mode, ColumnMode::Unknown) {
             self.mode = ColumnMode::Forward(HashMap::new());
@@ -287,7 +289,8 @@ impl LowRankCorrection {
         let ColumnMode::Forward(store) = &mut self.mode else {
             return;
         };
-        let mut product = Vec::new();
+        // Each block's new columns appended (a new block takes the solved values as they are).
+        let mut updated = Vec::with_capacity(w.blocks.len());
         for blk in w.blocks {
             let stored = store.entry(blk.block).or_insert_with(|| StoredBlock {
                 first_row: blk.first_row,
@@ -297,16 +300,33 @@ impl LowRankCorrection {
             });
             let old = stored.columns.len();
             stored.columns.extend(blk.columns.iter().map(|c| start + c));
-            stored.values.extend(blk.values);
-            let (rows, all) = (stored.rows, stored.columns.len());
-            let new = all - old;
-            let w_all = MatRef::from_column_major_slice(&stored.values, rows, all);
-            let threads = if rows * all * new > PARALLEL_PRODUCT {
-                rayon::current_num_threads()
+            if stored.values.is_empty() {
+                stored.values = blk.values;
             } else {
-                1
-            };
-            new_gram_columns(w_all, old, threads, &mut product);
+                stored.values.extend(blk.values);
+            }
+            updated.push((blk.block, old));
+        }
+        let store = &*store;
+        let products: Vec<Vec<f64>> = updated
+            .par_iter()
+            .map(|&(block, old)| {
+                let stored = &store[&block];
+                let (rows, all) = (stored.rows, stored.columns.len());
+                let w_all = MatRef::from_column_major_slice(&stored.values, rows, all);
+                let threads = if rows * all * (all - old) > PARALLEL_PRODUCT {
+                    rayon::current_num_threads()
+                } else {
+                    1
+                };
+                let mut product = Vec::new();
+                new_gram_columns(w_all, old, threads, &mut product);
+                product
+            })
+            .collect();
+        for (&(block, old), product) in updated.iter().zip(products) {
+            let stored = &store[&block];
+            let all = stored.columns.len();
             for (b, p) in product.chunks(all).enumerate() {
                 let col = stored.columns[old + b];
                 for (a, &v) in p.iter().enumerate() {
@@ -572,33 +592,6 @@ impl LowRankCorrection {
     }
 }
 
-/// `product` ← Wᵀ W[:, old..] (all × new, column-major) for W = `w`, the new columns split
-/// over `threads`, one sequential kernel each (faer's parallel kernel reached about half the
-/// rate on these shapes).
-fn new_gram_columns(w: MatRef<'_, f64>, old: usize, threads: usize, product: &mut Vec<f64>) {
-    let (all, new) = (w.ncols(), w.ncols() - old);
-    product.clear();
-    product.resize(all * new, 0.0);
-    if new == 0 {
-        return;
-    }
-    let chunk = new.div_ceil(threads.clamp(1, new));
-    product
-        .par_chunks_mut(all * chunk)
-        .enumerate()
-        .for_each(|(c, out)| {
-            let k = out.len() / all;
-            faer::linalg::matmul::matmul(
-                MatMut::from_column_major_slice_mut(out, all, k),
-                faer::Accum::Replace,
-                w.transpose(),
-                w.subcols(old + c * chunk, k),
-                1.0,
-                faer::Par::Seq,
-            );
-        });
-}
-
 /// A₀⁻¹ b₀ as [`LowRankCorrection::solve_from`] starts from it.
 #[derive(Clone, Debug)]
 pub(crate) enum Reference {
@@ -660,34 +653,6 @@ mod tests {
     use crate::solve::{make_solver, SolverKind};
     use fibercell_solver::{CscMatrix, Ordering};
     use nalgebra::{DMatrix, DVector};
-
-    /// The new columns of Wᵀ W split over 1, 2 and 3 threads (an uneven split included) equal
-    /// the entrywise dot products to 1e-14 relative.
-    #[test]
-    fn new_gram_columns_on_any_number_of_threads_are_the_dot_products() {
-        let (rows, all, old) = (37, 11, 4);
-        let values: Vec<f64> = (0..rows * all)
-            .map(|i| ((i * 7919) % 101) as f64 / 50.0 - 1.0)
-            .collect();
-        let w = MatRef::from_column_major_slice(&values, rows, all);
-        let mut product = Vec::new();
-        for threads in [1, 2, 3] {
-            new_gram_columns(w, old, threads, &mut product);
-            assert_eq!(product.len(), all * (all - old));
-            for b in 0..all - old {
-                for a in 0..all {
-                    let want: f64 = (0..rows).map(|r| w[(r, a)] * w[(r, old + b)]).sum();
-                    let got = product[b * all + a];
-                    assert!(
-                        (got - want).abs() <= 1e-14 * (1.0 + want.abs()),
-                        "{threads}: {got} vs {want}"
-                    );
-                }
-            }
-        }
-        new_gram_columns(w, all, 2, &mut product);
-        assert!(product.is_empty());
-    }
 
     /// The Woodbury solve equals a dense solve of A₀ + U E Uᵀ (a path-graph Laplacian plus a
     /// diagonal as A₀, contacts of 2, 3 and 6 columns on random DOFs, E nonsymmetric and

@@ -2,6 +2,7 @@
 
 mod backend;
 mod connectivity;
+mod gram;
 mod increment_timings;
 mod incremental;
 mod low_rank;
