@@ -24,6 +24,9 @@ use std::time::Instant;
 /// Repeats at least of the stages that take milliseconds (contact search, value fills), whose
 /// medians over a few runs still follow the noise of a shared machine.
 const SHORT_STAGE_REPEATS: usize = 15;
+/// Fewest runs of the first and next low-rank solves after switches (fractions of a second on
+/// L, with a spread of ±20 % between runs on the VMs measured).
+const LOW_RANK_REPEATS: usize = 7;
 
 /// Median of non-empty `times` (the upper one of an even count); 0 when empty.
 fn median(mut times: Vec<f64>) -> f64 {
@@ -122,7 +125,7 @@ pub struct ReuseBench {
     /// The low-rank (Woodbury) solve on faer's factor of the unswitched matrix, as the
     /// incremental solver does it: the 2k columns of S = Uᵀ A₀⁻¹ U (sparse forward solves), the
     /// factorization of the capacitance matrix and the solve (s); the median of `repeats` runs
-    /// from no columns. Absent in reports written before.
+    /// (at least seven) from no columns. Absent in reports written before.
     #[serde(default)]
     pub low_rank_seconds: Option<f64>,
     /// The next low-rank solve on the same columns as in a stick/slip iteration, whose load
@@ -354,9 +357,10 @@ fn bench_backend(
 /// The contacts `list` switched stick → sliding as the low-rank correction A₀ − W Wᵀ (W their
 /// stick-spring columns, E = −I) of the factorization `a0` of the unswitched matrix: seconds of
 /// the first solve (columns, LU, two solves) and its stages (columns, capacitance, solve) from
-/// the run of median total among `repeats` (each from no columns), the median seconds of the
-/// next solve on the same columns with the load changed within them (LU, one solve), and the
-/// first solves' largest backward error on the switched matrix `a`.
+/// the run of median total among `repeats` (at least [`LOW_RANK_REPEATS`], each from no
+/// columns), the median seconds of the next solve on the same columns with the load changed
+/// within them (LU, one solve), and the first solves' largest backward error on the switched
+/// matrix `a`.
 fn low_rank_switch(
     sys: &PeriodicSystem,
     a0: &mut dyn fibercell_solver::LinearSolver,
@@ -385,7 +389,7 @@ fn low_rank_switch(
     let mut firsts: Vec<(f64, [f64; 3])> = Vec::new();
     let mut nexts = Vec::new();
     let mut error = 0.0f64;
-    for _ in 0..repeats.max(1) {
+    for _ in 0..repeats.max(LOW_RANK_REPEATS) {
         let mut low_rank = LowRankCorrection::new(a.ncols(), list.len());
         let t = Instant::now();
         low_rank.extend(a0, &changes, column)?;
