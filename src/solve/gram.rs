@@ -20,23 +20,17 @@ struct Piece {
     from: usize,
 }
 
-/// `product` ← Wᵀ W[:, old..] (all × new, column-major) for W = `w`: the old columns against
+/// Wᵀ W[:, old..] (all × new, column-major) for W = `w`: the old columns against
 /// each panel of new ones, and the new panels pairwise (each pair once, mirrored), every
 /// product from the first row where its right panel (or, for new pairs, either panel) can be
 /// nonzero; the pieces on `threads` threads, one sequential kernel each (faer's parallel kernel
 /// reached about half the rate on these shapes).
-pub(crate) fn new_gram_columns(
-    w: MatRef<'_, f64>,
-    old: usize,
-    threads: usize,
-    product: &mut Vec<f64>,
-) {
+pub(crate) fn new_gram_columns(w: MatRef<'_, f64>, old: usize, threads: usize) -> Vec<f64> {
     let (rows, all) = (w.nrows(), w.ncols());
     let new = all - old;
-    product.clear();
-    product.resize(all * new, 0.0);
+    let mut product = vec![0.0; all * new];
     if new == 0 {
-        return;
+        return product;
     }
     // The first row each panel of new columns can be nonzero in.
     let panels: Vec<(std::ops::Range<usize>, usize)> = (old..all)
@@ -71,13 +65,12 @@ pub(crate) fn new_gram_columns(
     let multiply = |p: &Piece| {
         let (m, n) = (p.left.len(), p.right.len());
         let mut out = vec![0.0; m * n];
-        let tail = rows - p.from.min(rows);
+        let tail = rows - p.from;
         faer::linalg::matmul::matmul(
             MatMut::from_column_major_slice_mut(&mut out, m, n),
             Accum::Replace,
-            w.submatrix(p.from.min(rows), p.left.start, tail, m)
-                .transpose(),
-            w.submatrix(p.from.min(rows), p.right.start, tail, n),
+            w.submatrix(p.from, p.left.start, tail, m).transpose(),
+            w.submatrix(p.from, p.right.start, tail, n),
             1.0,
             Par::Seq,
         );
@@ -102,6 +95,7 @@ pub(crate) fn new_gram_columns(
             }
         }
     }
+    product
 }
 
 #[cfg(test)]
@@ -124,9 +118,8 @@ mod tests {
 
     fn check(values: &[f64], rows: usize, all: usize, old: usize) {
         let w = MatRef::from_column_major_slice(values, rows, all);
-        let mut product = Vec::new();
         for threads in [1, 2, 3] {
-            new_gram_columns(w, old, threads, &mut product);
+            let product = new_gram_columns(w, old, threads);
             assert_eq!(product.len(), all * (all - old));
             for b in 0..all - old {
                 for a in 0..all {
@@ -158,13 +151,7 @@ mod tests {
         let mixed = |c: usize| if c == 7 { 300 } else { (c * 37) % 290 };
         check(&with_leading_zeros(300, 250, mixed), 300, 250, 20);
         let w = with_leading_zeros(3, 2, dense);
-        let mut product = vec![1.0];
-        new_gram_columns(
-            MatRef::from_column_major_slice(&w, 3, 2),
-            2,
-            2,
-            &mut product,
-        );
+        let product = new_gram_columns(MatRef::from_column_major_slice(&w, 3, 2), 2, 2);
         assert!(product.is_empty());
     }
 }

@@ -319,9 +319,7 @@ impl LowRankCorrection {
                 } else {
                     1
                 };
-                let mut product = Vec::new();
-                new_gram_columns(w_all, old, threads, &mut product);
-                product
+                new_gram_columns(w_all, old, threads)
             })
             .collect();
         for (&(block, old), product) in updated.iter().zip(products) {
