@@ -131,6 +131,9 @@ fn supervariables(a: CscRef<'_>) -> (Vec<usize>, Vec<usize>) {
 /// METIS_OPTION_NSEPS of the nested dissection.
 const SEPARATORS_TRIED: metis_sys::idx_t = 5;
 
+/// Held while METIS orders (see `nested_dissection`).
+static METIS_TURN: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn nested_dissection(a: CscRef<'_>) -> Result<Permutation, SolverError> {
     let n = a.ncols();
     if n <= 1 {
@@ -165,6 +168,11 @@ fn nested_dissection(a: CscRef<'_>) -> Result<Permutation, SolverError> {
     let mut options = [0 as metis_sys::idx_t; metis_sys::METIS_NOPTIONS as usize];
     let mut perm = vec![0 as metis_sys::idx_t; m];
     let mut iperm = vec![0 as metis_sys::idx_t; m];
+    // METIS draws from one process-wide random state: concurrent calls race on it (and order
+    // differently from run to run), so they take turns.
+    let _turn = METIS_TURN
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
     // SAFETY: all arrays have the sizes METIS documents (xadj m+1, adjncy xadj[m], vwgt m,
     // options METIS_NOPTIONS, perm/iperm m) and live across the calls.
     let status = unsafe {
@@ -231,6 +239,30 @@ mod tests {
             }
         }
         CscMatrix::from_triplets(k * k * dofs, k * k * dofs, &t).unwrap()
+    }
+
+    /// Nested dissection gives the same permutation when several threads order at once
+    /// (METIS draws from one process-wide random state).
+    #[test]
+    fn nested_dissection_is_the_same_on_concurrent_threads() {
+        let a = grid_laplacian(30, 3);
+        let want = compute_ordering(a.as_ref(), &Ordering::NestedDissection).unwrap();
+        std::thread::scope(|scope| {
+            let runs: Vec<_> = (0..4)
+                .map(|_| {
+                    scope.spawn(|| {
+                        (0..20)
+                            .map(|_| compute_ordering(a.as_ref(), &Ordering::NestedDissection))
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            for run in runs {
+                for p in run.join().unwrap() {
+                    assert_eq!(p.unwrap().fwd, want.fwd);
+                }
+            }
+        });
     }
 
     #[test]
