@@ -8,6 +8,7 @@ mod column_layout;
 mod lu;
 mod pivots;
 mod sparse_forward;
+mod top_columns;
 
 pub use cholesky::{CholeskyVariant, FaerCholesky};
 pub use lu::FaerLu;

@@ -3,6 +3,7 @@
 
 use crate::block_solve::SolveSchedule;
 use crate::column_layout::ColumnLayout;
+use crate::top_columns::TopColumns;
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{Reborrow, ReborrowMut};
@@ -201,7 +202,8 @@ impl BlockTree {
         // Groups: the touched blocks of each task of `schedule` (disjoint subtrees, one thread
         // each) and the top ones, each ascending (children before parents). A block's
         // ancestors are in its own group or among the top blocks; a task adds to the top
-        // blocks in private copies, summed before the top blocks follow.
+        // blocks' columns through [`TopColumns`] (directly where it is the first task reaching
+        // a column, else privately, summed before the top blocks follow).
         let task_of = schedule.task_of(self.parent.len());
         let top = schedule.task_count();
         let group_of: Vec<usize> = touched
@@ -221,7 +223,6 @@ impl BlockTree {
             .iter()
             .map(|list| list.iter().map(|&k| std::mem::take(&mut x[k])).collect())
             .collect();
-        let top_sizes: Vec<usize> = lists[top].iter().map(|&k| x_len[k]).collect();
         let walk = Walk {
             tree: self,
             symbolic,
@@ -234,30 +235,43 @@ impl BlockTree {
             layouts: &layouts,
             par,
         };
+        // The columns each task reaches, and the column held by each top block's storage
+        // columns: a task adds to the top columns it owns directly, to others privately.
+        let reached: Vec<Vec<bool>> = lists[..top]
+            .iter()
+            .map(|list| {
+                let mut marks = vec![false; columns.len()];
+                for &k in list {
+                    members[touched[k]].iter().for_each(|&j| marks[j] = true);
+                }
+                marks
+            })
+            .collect();
+        let widths: Vec<usize> = lists[top]
+            .iter()
+            .map(|&k| self.shapes[touched[k]].width)
+            .collect();
+        let storage: Vec<Vec<usize>> = lists[top]
+            .iter()
+            .map(|&k| {
+                let m = &members[touched[k]];
+                layouts[k]
+                    .as_ref()
+                    .map_or_else(|| m.clone(), |l| l.order.iter().map(|&c| m[c]).collect())
+            })
+            .collect();
         let (tasks, top_group) = groups.split_at_mut(top);
-        let top_xs = &mut top_group[0];
-        // The first task adds to the top blocks themselves, the others to private copies.
-        let mut copies: Vec<Vec<Vec<f64>>> = vec![Vec::new(); top.saturating_sub(1)];
-        let mut targets: Vec<&mut Vec<Vec<f64>>> = Vec::with_capacity(top);
-        targets.push(top_xs);
-        targets.extend(copies.iter_mut());
+        let mut access = TopColumns::split(&mut top_group[0], &widths, &storage, &reached);
         tasks
             .par_iter_mut()
             .zip(&lists[..top])
-            .zip(targets)
+            .zip(access.par_iter_mut())
             .enumerate()
             .for_each(|(g, ((mine, list), target))| {
-                if g > 0 {
-                    *target = top_sizes.iter().map(|&n| vec![0.0; n]).collect();
-                }
                 walk.eliminate(g, list, mine, Some(target));
             });
+        TopColumns::join(access);
         let top_xs = &mut top_group[0];
-        for copy in copies {
-            for (xt, c) in top_xs.iter_mut().zip(copy) {
-                xt.iter_mut().zip(c).for_each(|(a, b)| *a += b);
-            }
-        }
         walk.eliminate(top, &lists[top], top_xs, None);
         for (list, group) in lists.iter().zip(groups) {
             for (&k, xk) in list.iter().zip(group) {
@@ -372,14 +386,14 @@ struct Walk<'a> {
 impl Walk<'_> {
     /// Eliminates the touched blocks `list` of group `group` (ascending), their solutions
     /// `mine` (in list order): each block's rows solved, its rows below subtracted from its
-    /// ancestors' — in `mine`, or for top blocks of another group in `top_copy` (by their
-    /// position among the top blocks).
+    /// ancestors' — in `mine`, or for top blocks of another group through `top_columns` (by
+    /// their position among the top blocks).
     fn eliminate(
         &self,
         group: usize,
         list: &[usize],
         mine: &mut [Vec<f64>],
-        mut top_copy: Option<&mut Vec<Vec<f64>>>,
+        mut top_columns: Option<&mut TopColumns<'_>>,
     ) {
         let mut below = Vec::new();
         let mut position = Vec::new();
@@ -465,10 +479,8 @@ impl Walk<'_> {
             let mut r0 = 0;
             while r0 < p {
                 let t = self.tree.block_of[b.pattern[r0]];
-                let mut r1 = r0 + 1;
-                while r1 < p && self.tree.block_of[b.pattern[r1]] == t {
-                    r1 += 1;
-                }
+                let end = self.tree.shapes[t].begin + self.tree.shapes[t].width;
+                let r1 = r0 + b.pattern[r0..].partition_point(|&row| row < end);
                 // Storage column of this block → storage column of the ancestor.
                 let kt = self.slot[t];
                 let ancestor = self.layouts[kt].as_ref();
@@ -482,21 +494,36 @@ impl Walk<'_> {
                     position[layout.map_or(c, |l| l.position[c])] =
                         ancestor.map_or(at, |l| l.position[at]);
                 }
-                let xt = if self.group_of[kt] == group {
-                    &mut rest[self.index[kt] - i - 1]
-                } else {
-                    match top_copy.as_deref_mut() {
-                        Some(copy) => &mut copy[self.index[kt]],
-                        // The top group's ancestors are top blocks.
-                        None => unreachable!("an ancestor outside the top group"),
-                    }
-                };
                 let bt = &self.tree.shapes[t];
                 let rows = &b.pattern[r0..r1];
-                for (c, &at) in position.iter().enumerate() {
-                    let out = &mut xt[at * bt.width..(at + 1) * bt.width];
-                    for (&row, v) in rows.iter().zip(&below[c * p + r0..c * p + r1]) {
-                        out[row - bt.begin] -= v;
+                let (first, len) = (rows[0] - bt.begin, r1 - r0);
+                // Ascending and distinct: contiguous exactly when the last row is len − 1 on.
+                let contiguous = rows[len - 1] - rows[0] == len - 1;
+                let subtract = |out: &mut [f64], c: usize| {
+                    let from = &below[c * p + r0..c * p + r1];
+                    if contiguous {
+                        out[first..first + len]
+                            .iter_mut()
+                            .zip(from)
+                            .for_each(|(o, v)| *o -= v);
+                    } else {
+                        for (&row, v) in rows.iter().zip(from) {
+                            out[row - bt.begin] -= v;
+                        }
+                    }
+                };
+                if self.group_of[kt] == group {
+                    let xt = &mut rest[self.index[kt] - i - 1];
+                    for (c, &at) in position.iter().enumerate() {
+                        subtract(&mut xt[at * bt.width..(at + 1) * bt.width], c);
+                    }
+                } else {
+                    // The top group's ancestors are top blocks.
+                    let Some(top) = top_columns.as_deref_mut() else {
+                        unreachable!("an ancestor outside the top group")
+                    };
+                    for (c, &at) in position.iter().enumerate() {
+                        subtract(top.column(self.index[kt], at), c);
                     }
                 }
                 r0 = r1;
@@ -507,7 +534,7 @@ impl Walk<'_> {
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use super::BlockTree;
+    use super::{BlockTree, NONE};
     use crate::{CholeskyVariant, FaerCholesky};
     use faer::Par;
     use fibercell_solver::{CscMatrix, LinearSolver, Ordering, SolverError};
@@ -620,7 +647,7 @@ pub(crate) mod tests {
     }
 
     /// With the subtrees of the block tree on 2 and 3 tasks (their updates of the top blocks
-    /// in private copies) the sparse forward solve gives the one-group result: the same blocks
+    /// direct or private by column) the sparse forward solve gives the one-group result: the same blocks
     /// and columns, values to 1e-12.
     #[test]
     fn sparse_forward_solve_on_subtree_tasks_matches_one_group() {
@@ -635,6 +662,26 @@ pub(crate) mod tests {
         for threads in [2, 3] {
             let schedule = SolveSchedule::with_threshold(&tree, threads, 0);
             assert_eq!(schedule.task_count(), threads);
+            // Both kinds of top columns occur: reached by one task only (written directly)
+            // and by several (the later tasks' parts private).
+            let task_of = schedule.task_of(tree.parent.len());
+            let reaching: Vec<usize> = b
+                .iter()
+                .map(|col| {
+                    let mut tasks: Vec<usize> = col
+                        .iter()
+                        .map(|&(i, _)| task_of[tree.block_of[factor.inv[i]]])
+                        .filter(|&t| t != NONE)
+                        .collect();
+                    tasks.sort_unstable();
+                    tasks.dedup();
+                    tasks.len()
+                })
+                .collect();
+            assert!(
+                reaching.contains(&1) && reaching.iter().any(|&k| k > 1),
+                "{threads} tasks: {reaching:?}"
+            );
             let got = forward(&schedule);
             assert_eq!(got.blocks.len(), one.blocks.len());
             let big = one
