@@ -9,6 +9,9 @@
 use crate::sparse_forward::NONE;
 use std::marker::PhantomData;
 
+/// Marks a column a task does not reach (and must not write).
+const UNREACHED: usize = NONE - 1;
+
 /// The top blocks' solution values as the tasks share them: one base pointer per top block
 /// (its `width × columns` values, column-major in storage order).
 #[derive(Clone, Copy)]
@@ -24,7 +27,8 @@ pub(crate) struct TopColumns<'a> {
     /// Per top block: its values and its width.
     bases: Vec<(Base, usize)>,
     /// Per top block, per storage column: `NONE` when this task owns the column (writes it
-    /// directly), else the offset of its private column in `private`.
+    /// directly), `UNREACHED` when it does not reach it, else the offset of its private column
+    /// in `private`.
     private_at: Vec<Vec<usize>>,
     /// The private columns, zero until the task subtracts from them.
     private: Vec<f64>,
@@ -74,7 +78,9 @@ impl<'a> TopColumns<'a> {
                     .map(|(cols, &w)| {
                         cols.iter()
                             .map(|&j| {
-                                if owner[j] == g || !marks[j] {
+                                if !marks[j] {
+                                    UNREACHED
+                                } else if owner[j] == g {
                                     NONE
                                 } else {
                                     len += w;
@@ -94,11 +100,14 @@ impl<'a> TopColumns<'a> {
             .collect()
     }
 
-    /// Storage column `at` of top block `block`, one of the columns this task reaches (the
-    /// others are owned by a task reaching them, and not to be written here).
+    /// Storage column `at` of top block `block`, one of the columns this task reaches.
+    ///
+    /// # Panics
+    /// On a column this task does not reach (another task may own it).
     pub(crate) fn column(&mut self, block: usize, at: usize) -> &mut [f64] {
         let (base, w) = self.bases[block];
         match self.private_at[block][at] {
+            UNREACHED => panic!("top column {at} of block {block} is not this task's"),
             // SAFETY: this task owns the column (no other access writes or reads it before
             // `join`), and `at` indexes `private_at`, so the column lies within the block's
             // `width × columns` values (asserted in `split`).
@@ -109,22 +118,18 @@ impl<'a> TopColumns<'a> {
 
     /// Adds every access's private columns into the top blocks, ending the borrow.
     pub(crate) fn join(tasks: Vec<TopColumns<'a>>) {
-        for mut task in tasks {
-            let private = std::mem::take(&mut task.private);
-            for block in 0..task.bases.len() {
-                for at in 0..task.private_at[block].len() {
-                    let offset = task.private_at[block][at];
-                    if offset == NONE {
+        for task in tasks {
+            for (&(base, w), offsets) in task.bases.iter().zip(&task.private_at) {
+                for (at, &offset) in offsets.iter().enumerate() {
+                    if offset == NONE || offset == UNREACHED {
                         continue;
                     }
-                    let w = task.bases[block].1;
-                    let (base, _) = task.bases[block];
                     // SAFETY: every access has been given back, so nothing else touches the
                     // top blocks; the column lies within the block (as in `column`).
                     let column = unsafe { std::slice::from_raw_parts_mut(base.0.add(at * w), w) };
                     column
                         .iter_mut()
-                        .zip(&private[offset..offset + w])
+                        .zip(&task.private[offset..offset + w])
                         .for_each(|(t, p)| *t += p);
                 }
             }
@@ -157,5 +162,15 @@ mod tests {
         tasks[1].column(0, 2).iter_mut().for_each(|v| *v -= 8.0);
         TopColumns::join(tasks);
         assert_eq!(top[0], vec![0.0, 0.0, -5.0, -5.0, -7.0, -7.0]);
+    }
+
+    /// A task asking for a column it does not reach (owned by another task) is refused.
+    #[test]
+    #[should_panic(expected = "not this task's")]
+    fn a_column_the_task_does_not_reach_is_refused() {
+        let mut top = vec![vec![0.0; 4]];
+        let reached = vec![vec![true, false], vec![false, true]];
+        let mut tasks = TopColumns::split(&mut top, &[2], &[vec![0, 1]], &reached);
+        tasks[1].column(0, 0);
     }
 }
