@@ -24,6 +24,8 @@ const MAX_SPLITS: usize = 512;
 /// Blocks with at least this many values use faer's dense kernels (runtime-dispatched SIMD);
 /// smaller ones the plain loops, whose call overhead is lower.
 const DENSE_KERNEL_VALUES: usize = 1 << 10;
+/// Top blocks with at least this many values run faer's kernels on all threads.
+const PARALLEL_BLOCK_VALUES: usize = 1 << 20;
 /// Factors with fewer values are solved on one thread.
 const PARALLEL_VALUES: usize = 1 << 20;
 
@@ -196,7 +198,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// Forward elimination of one block: its rows `top` solved in place, `below` set to what its
 /// pattern rows lose.
-fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>) {
+fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>, par: Par) {
     let ld = b.width + b.pattern.len();
     below.clear();
     below.resize(b.pattern.len(), 0.0);
@@ -204,14 +206,14 @@ fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>) {
         let (l_top, l_bottom) =
             MatRef::from_column_major_slice(b.values, ld, b.width).split_at_row(b.width);
         let mut x = MatMut::from_column_major_slice_mut(top, b.width, 1);
-        solve_lower_triangular_in_place(l_top, x.rb_mut(), Par::Seq);
+        solve_lower_triangular_in_place(l_top, x.rb_mut(), par);
         matmul(
             MatMut::from_column_major_slice_mut(below, b.pattern.len(), 1),
             Accum::Replace,
             l_bottom,
             x.rb(),
             1.0,
-            Par::Seq,
+            par,
         );
         return;
     }
@@ -230,7 +232,7 @@ fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>) {
 
 /// Back substitution of one block: its rows `top` from the final values `below` of its
 /// pattern rows.
-fn backward_block(b: &Block<'_>, top: &mut [f64], below: &[f64]) {
+fn backward_block(b: &Block<'_>, top: &mut [f64], below: &[f64], par: Par) {
     let ld = b.width + b.pattern.len();
     if b.values.len() >= DENSE_KERNEL_VALUES {
         let (l_top, l_bottom) =
@@ -242,15 +244,26 @@ fn backward_block(b: &Block<'_>, top: &mut [f64], below: &[f64]) {
             l_bottom.transpose(),
             MatRef::from_column_major_slice(below, b.pattern.len(), 1),
             -1.0,
-            Par::Seq,
+            par,
         );
-        solve_upper_triangular_in_place(l_top.transpose(), x, Par::Seq);
+        solve_upper_triangular_in_place(l_top.transpose(), x, par);
         return;
     }
     for c in (0..b.width).rev() {
         let col = &b.values[c * ld..(c + 1) * ld];
         let sum = dot(&col[c + 1..b.width], &top[c + 1..]) + dot(&col[b.width..], below);
         top[c] = (top[c] - sum) / col[c];
+    }
+}
+
+/// The threads of a top block's kernels: those of `schedule` for the largest blocks (each
+/// read once per solve, bandwidth-bound on one core).
+fn top_par(b: &Block<'_>, schedule: &SolveSchedule) -> Par {
+    let threads = schedule.task_count();
+    if threads > 1 && b.values.len() >= PARALLEL_BLOCK_VALUES {
+        Par::rayon(threads)
+    } else {
+        Par::Seq
     }
 }
 
@@ -288,7 +301,7 @@ pub(crate) fn forward_in_place(
                 // SAFETY: a block's rows and the rows below it that are not top rows lie in
                 // this task's subtrees, which no other task touches; top rows go to `update`.
                 let top = unsafe { std::slice::from_raw_parts_mut(shared.at(b.begin), b.width) };
-                forward_block(&b, top, &mut below);
+                forward_block(&b, top, &mut below, Par::Seq);
                 for (&row, t) in b.pattern.iter().zip(&below) {
                     match top_index[row] {
                         NONE => unsafe { *shared.at(row) -= t },
@@ -313,7 +326,12 @@ pub(crate) fn forward_in_place(
     }
     for &s in &schedule.top {
         let b = tree.block(symbolic, values, s);
-        forward_block(&b, &mut x[b.begin..b.begin + b.width], &mut below);
+        forward_block(
+            &b,
+            &mut x[b.begin..b.begin + b.width],
+            &mut below,
+            top_par(&b, schedule),
+        );
         for (&row, t) in b.pattern.iter().zip(&below) {
             x[row] -= t;
         }
@@ -333,7 +351,12 @@ pub(crate) fn backward_in_place(
         let b = tree.block(symbolic, values, s);
         below.clear();
         below.extend(b.pattern.iter().map(|&row| x[row]));
-        backward_block(&b, &mut x[b.begin..b.begin + b.width], &below);
+        backward_block(
+            &b,
+            &mut x[b.begin..b.begin + b.width],
+            &below,
+            top_par(&b, schedule),
+        );
     }
     let shared = Shared(x.as_mut_ptr());
     schedule.tasks.par_iter().for_each(|blocks| {
@@ -345,7 +368,7 @@ pub(crate) fn backward_in_place(
             // (final, only read now); the block's own rows are this task's.
             below.extend(b.pattern.iter().map(|&row| unsafe { *shared.at(row) }));
             let top = unsafe { std::slice::from_raw_parts_mut(shared.at(b.begin), b.width) };
-            backward_block(&b, top, &below);
+            backward_block(&b, top, &below, Par::Seq);
         }
     });
 }

@@ -8,6 +8,7 @@
 use crate::block_solve::{
     backward_in_place, forward_in_place, solve_in_place as block_solve, SolveSchedule,
 };
+use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
 use crate::sparse_forward::{BlockTree, FactorView};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -44,6 +45,8 @@ pub struct FaerCholesky {
     par: Par,
     analysis: Option<Analysis>,
     factor: Option<Factor>,
+    /// One right-hand side in the factor's order, kept between solves.
+    work: Vec<f64>,
 }
 
 struct Analysis {
@@ -57,7 +60,9 @@ struct Analysis {
     tree: BlockTree,
     /// Its blocks per thread for solves with one right-hand side.
     schedule: SolveSchedule,
-    /// The inverse of the permutation faer solves with (x[new] = b[fwd[new]]), `inv[old] = new`.
+    /// The permutation faer solves with, x[new] = b[fwd[new]].
+    factor_fwd: Vec<usize>,
+    /// Its inverse, `inv[old] = new`.
     factor_inv: Vec<usize>,
 }
 
@@ -96,6 +101,7 @@ impl FaerCholesky {
             par: Par::rayon(0),
             analysis: None,
             factor: None,
+            work: Vec::new(),
         }
     }
 
@@ -237,6 +243,10 @@ impl LinearSolver for FaerCholesky {
             perm,
             schedule: SolveSchedule::new(&tree, threads(self.par)),
             tree,
+            factor_fwd: match symbolic.perm() {
+                Some(p) => p.arrays().0.to_vec(),
+                None => (0..n).collect(),
+            },
             factor_inv: match symbolic.perm() {
                 Some(p) => p.arrays().1.to_vec(),
                 None => (0..n).collect(),
@@ -351,14 +361,12 @@ impl LinearSolver for FaerCholesky {
             // One right-hand side on a factor large enough to split over the threads: our
             // block solve (faer's runs at a quarter of the bandwidth; on a factor that fits in
             // cache faer's kernels are faster).
-            let mut x = vec![0.0; n];
-            for (old, &new) in an.factor_inv.iter().enumerate() {
-                x[new] = rhs[old] * f.scale[old];
-            }
+            let mut x = std::mem::take(&mut self.work);
+            x.resize(n, 0.0);
+            permute::into_factor_order(rhs, &f.scale, &an.factor_fwd, &mut x, true);
             block_solve(&an.tree, &an.schedule, &an.symbolic, &f.l_values, &mut x);
-            for (old, &new) in an.factor_inv.iter().enumerate() {
-                rhs[old] = x[new] * f.scale[old];
-            }
+            permute::from_factor_order(&x, &f.scale, &an.factor_inv, rhs, true);
+            self.work = x;
             return Ok(SolveInfo::default());
         }
         for col in rhs.chunks_mut(n) {
@@ -403,28 +411,28 @@ impl LinearSolver for FaerCholesky {
     }
 
     fn solve_lower_in_place(&mut self, x: &mut [f64]) -> Result<(), SolverError> {
+        let mut y = std::mem::take(&mut self.work);
         let (an, f) = self.llt_parts()?;
         <dyn LinearSolver>::check_rhs(an.n, x, 1)?;
-        let mut y = vec![0.0; an.n];
-        for (old, &new) in an.factor_inv.iter().enumerate() {
-            y[new] = x[old] * f.scale[old];
-        }
+        let parallel = an.schedule.is_parallel();
+        y.resize(an.n, 0.0);
+        permute::into_factor_order(x, &f.scale, &an.factor_fwd, &mut y, parallel);
         forward_in_place(&an.tree, &an.schedule, &an.symbolic, &f.l_values, &mut y);
-        x.copy_from_slice(&y);
+        permute::copy(&y, x, parallel);
+        self.work = y;
         Ok(())
     }
 
     fn solve_upper_in_place(&mut self, y: &mut [f64]) -> Result<(), SolverError> {
+        let mut x = std::mem::take(&mut self.work);
         let (an, f) = self.llt_parts()?;
         <dyn LinearSolver>::check_rhs(an.n, y, 1)?;
+        let parallel = an.schedule.is_parallel();
         backward_in_place(&an.tree, &an.schedule, &an.symbolic, &f.l_values, y);
-        let x: Vec<f64> = an
-            .factor_inv
-            .iter()
-            .zip(&f.scale)
-            .map(|(&new, s)| y[new] * s)
-            .collect();
-        y.copy_from_slice(&x);
+        x.resize(an.n, 0.0);
+        permute::from_factor_order(y, &f.scale, &an.factor_inv, &mut x, parallel);
+        permute::copy(&x, y, parallel);
+        self.work = x;
         Ok(())
     }
 

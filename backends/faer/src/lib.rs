@@ -6,6 +6,7 @@ mod block_solve;
 mod cholesky;
 mod column_layout;
 mod lu;
+mod permute;
 mod pivots;
 mod sparse_forward;
 mod top_columns;
