@@ -472,7 +472,12 @@ impl LowRankCorrection {
         b: &[f64],
     ) -> Result<Vec<f64>, SolverError> {
         let reference = self.reference(a0, b.to_vec())?;
-        self.solve_from(a0, cap, &reference, &vec![0.0; cap.order()])
+        let v = self.coefficients(cap, &reference, &vec![0.0; cap.order()])?;
+        match reference {
+            // The forward half is not needed afterwards: the backward half runs in place.
+            Reference::Forward(f) => self.backward_from(a0, f, &v),
+            full => self.finish(a0, &full, &v),
+        }
     }
 
     /// A₀⁻¹ b₀ for later [`LowRankCorrection::solve_from`]: its forward half when S comes from
@@ -498,6 +503,18 @@ impl LowRankCorrection {
     pub(crate) fn solve_from(
         &self,
         a0: &mut dyn LinearSolver,
+        cap: &Capacitance,
+        reference: &Reference,
+        load: &[f64],
+    ) -> Result<Vec<f64>, SolverError> {
+        let v = self.coefficients(cap, reference, load)?;
+        self.finish(a0, reference, &v)
+    }
+
+    /// The coefficients v = Δχ − z of U's columns in the solution of
+    /// [`LowRankCorrection::solve_from`], z from the capacitance system.
+    fn coefficients(
+        &self,
         cap: &Capacitance,
         reference: &Reference,
         load: &[f64],
@@ -532,22 +549,41 @@ impl LowRankCorrection {
         for ((&c, l), zj) in cap.active.iter().zip(load).zip(&z) {
             v[c] += l - zj;
         }
+        Ok(v)
+    }
+
+    /// x = Ŝ Pᵀ L⁻ᵀ (f + W v) from the forward half f = L⁻¹ P Ŝ b₀ (taken) and the
+    /// coefficients `v` of U's columns.
+    fn backward_from(
+        &self,
+        a0: &mut dyn LinearSolver,
+        mut f: Vec<f64>,
+        v: &[f64],
+    ) -> Result<Vec<f64>, SolverError> {
+        self.forward_spread(v, &mut f);
+        a0.solve_upper_in_place(&mut f)?;
+        Ok(f)
+    }
+
+    /// x = A₀⁻¹ b₀ + A₀⁻¹ U v from `reference` (A₀⁻¹ b₀ or its forward half) and the
+    /// coefficients `v` of U's columns.
+    fn finish(
+        &self,
+        a0: &mut dyn LinearSolver,
+        reference: &Reference,
+        v: &[f64],
+    ) -> Result<Vec<f64>, SolverError> {
         match (reference, &self.mode) {
-            (Reference::Forward(f0), _) => {
-                let mut f = f0.clone();
-                self.forward_spread(&v, &mut f);
-                a0.solve_upper_in_place(&mut f)?;
-                Ok(f)
-            }
+            (Reference::Forward(f0), _) => self.backward_from(a0, f0.clone(), v),
             (Reference::Full(x0), ColumnMode::Forward(_)) => {
                 let mut w = vec![0.0; self.n];
-                self.forward_spread(&v, &mut w);
+                self.forward_spread(v, &mut w);
                 a0.solve_upper_in_place(&mut w)?;
                 Ok(x0.iter().zip(&w).map(|(x, w)| x + w).collect())
             }
             (Reference::Full(x0), _) => {
                 let mut w = vec![0.0; self.n];
-                for (col, &vj) in self.columns.iter().zip(&v) {
+                for (col, &vj) in self.columns.iter().zip(v) {
                     if vj != 0.0 {
                         col.iter().for_each(|&(i, u)| w[i] += u * vj);
                     }
