@@ -15,7 +15,8 @@
 use super::gram::new_gram_columns;
 use crate::contact::BlockCoefficients;
 use faer::linalg::solvers::{PartialPivLu, Solve};
-use faer::{Mat, MatMut, MatRef};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatMut, MatRef, Par};
 use fibercell_solver::{ForwardColumns, LinearSolver, SolverError};
 use nalgebra::Vector6;
 use rayon::prelude::*;
@@ -110,6 +111,23 @@ struct StoredBlock {
     rows: usize,
     columns: Vec<usize>,
     values: Vec<f64>,
+}
+
+impl StoredBlock {
+    /// Its values as a `rows × columns` matrix.
+    fn matrix(&self) -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice(&self.values, self.rows, self.columns.len())
+    }
+
+    /// The threads of a product with one vector: all of them for a block of at least
+    /// [`PARALLEL_PRODUCT`] values (read once, bandwidth-bound on one core).
+    fn par(&self) -> Par {
+        if self.values.len() >= PARALLEL_PRODUCT {
+            Par::rayon(0)
+        } else {
+            Par::Seq
+        }
+    }
 }
 
 /// The factorized capacitance matrix I + E S of one set of changes.
@@ -600,8 +618,17 @@ impl LowRankCorrection {
         if let ColumnMode::Forward(store) = &self.mode {
             for blk in store.values() {
                 let rows = &f[blk.first_row..blk.first_row + blk.rows];
-                for (values, &c) in blk.values.chunks(blk.rows).zip(&blk.columns) {
-                    out[c] += values.iter().zip(rows).map(|(w, x)| w * x).sum::<f64>();
+                let mut products = Mat::<f64>::zeros(blk.columns.len(), 1);
+                matmul(
+                    products.as_mut(),
+                    Accum::Replace,
+                    blk.matrix().transpose(),
+                    MatRef::from_column_major_slice(rows, blk.rows, 1),
+                    1.0,
+                    blk.par(),
+                );
+                for (k, &c) in blk.columns.iter().enumerate() {
+                    out[c] += products[(k, 0)];
                 }
             }
         }
@@ -613,14 +640,22 @@ impl LowRankCorrection {
     fn forward_spread(&self, v: &[f64], out: &mut [f64]) {
         if let ColumnMode::Forward(store) = &self.mode {
             for blk in store.values() {
-                let rows = &mut out[blk.first_row..blk.first_row + blk.rows];
-                for (values, &c) in blk.values.chunks(blk.rows).zip(&blk.columns) {
-                    if v[c] != 0.0 {
-                        rows.iter_mut()
-                            .zip(values)
-                            .for_each(|(o, w)| *o += w * v[c]);
-                    }
+                let coefficients: Vec<f64> = blk.columns.iter().map(|&c| v[c]).collect();
+                if coefficients.iter().all(|&x| x == 0.0) {
+                    continue;
                 }
+                matmul(
+                    MatMut::from_column_major_slice_mut(
+                        &mut out[blk.first_row..blk.first_row + blk.rows],
+                        blk.rows,
+                        1,
+                    ),
+                    Accum::Add,
+                    blk.matrix(),
+                    MatRef::from_column_major_slice(&coefficients, blk.columns.len(), 1),
+                    1.0,
+                    blk.par(),
+                );
             }
         }
     }
