@@ -17,6 +17,9 @@ pub(crate) const NONE: usize = usize::MAX;
 
 /// Products of a block below which the dense kernels run single-threaded.
 const PARALLEL_FLOPS: usize = 1 << 20;
+/// Subtree tasks whose flops are within this factor of an even share keep each block on one
+/// thread (on L at 1 %: the tasks' phase 51-53 → 46-50 ms).
+const TASK_BALANCE: f64 = 1.1;
 
 /// A numeric LLᵀ factor as the solves read it.
 #[derive(Clone, Copy)]
@@ -223,6 +226,20 @@ impl BlockTree {
             .iter()
             .map(|list| list.iter().map(|&k| std::mem::take(&mut x[k])).collect())
             .collect();
+        // The tasks' flops: when balanced, their blocks' columns stay on one thread (split
+        // pieces each read the whole block, with fewer columns per product); else they are
+        // split, and the idle thread takes pieces of the busy one's blocks.
+        let flops: Vec<usize> = lists[..top]
+            .iter()
+            .map(|list| {
+                list.iter()
+                    .map(|&k| {
+                        let b = &self.shapes[touched[k]];
+                        (b.width + b.pattern.len()) * b.width * members[touched[k]].len()
+                    })
+                    .sum()
+            })
+            .collect();
         let walk = Walk {
             tree: self,
             symbolic,
@@ -234,6 +251,7 @@ impl BlockTree {
             index: &index,
             layouts: &layouts,
             par,
+            split_in_tasks: !balanced(&flops),
         };
         // The columns each task reaches, and the column held by each top block's storage
         // columns: a task adds to the top columns it owns directly, to others privately.
@@ -363,6 +381,13 @@ impl BlockTree {
     }
 }
 
+/// Whether the largest of `loads` is within [`TASK_BALANCE`] of an even share.
+fn balanced(loads: &[usize]) -> bool {
+    let most = loads.iter().copied().max().unwrap_or(0) as f64;
+    let even = loads.iter().sum::<usize>() as f64 / loads.len().max(1) as f64;
+    most <= TASK_BALANCE * even
+}
+
 /// What eliminating the touched blocks of one group needs.
 struct Walk<'a> {
     tree: &'a BlockTree,
@@ -381,6 +406,8 @@ struct Walk<'a> {
     /// Per touched block: the order of its stored columns when not ascending.
     layouts: &'a [Option<ColumnLayout>],
     par: Par,
+    /// Whether the subtree tasks split a large block's columns over the threads.
+    split_in_tasks: bool,
 }
 
 impl Walk<'_> {
@@ -409,9 +436,11 @@ impl Walk<'_> {
             below.clear();
             below.resize(b.pattern.len() * m, 0.0);
             // Large blocks: the columns split over the threads, each solved and multiplied by
-            // one thread's kernels (faer's parallel kernels reached half the rate here).
+            // one thread's kernels (faer's parallel kernels reached half the rate here); in a
+            // subtree task only when the tasks are unbalanced.
+            let split = top_columns.is_none() || self.split_in_tasks;
             let threads = match self.par {
-                Par::Rayon(t) if rows * b.width * m > PARALLEL_FLOPS => t.get().min(m),
+                Par::Rayon(t) if split && rows * b.width * m > PARALLEL_FLOPS => t.get().min(m),
                 _ => 1,
             };
             let (w, p) = (b.width, b.pattern.len());
@@ -700,6 +729,70 @@ pub(crate) mod tests {
 
     /// Blocks large enough to split their columns over threads (the top separators of a 20³
     /// grid with 47 columns) give the sequential result to 1e-12, on 2 and 3 threads.
+    /// With the subtrees on two tasks and two threads the forward solve matches the
+    /// sequential one, for columns spread over the cell and for columns all in one task's
+    /// subtrees (unbalanced: that task's large blocks split over the threads).
+    #[test]
+    fn sparse_forward_solve_on_tasks_with_and_without_splits_matches_sequential() {
+        use crate::block_solve::SolveSchedule;
+        let (n, _, s) = grid_factor(20);
+        let factor = s.factor_view();
+        let tree = BlockTree::of(factor.symbolic);
+        let one = SolveSchedule::with_threshold(&tree, 1, 0);
+        let tasks = SolveSchedule::with_threshold(&tree, 2, 0);
+        let task_of = tasks.task_of(tree.parent.len());
+        let task = |i: usize| task_of[tree.block_of[factor.inv[i]]];
+        let spread: Vec<Vec<(usize, f64)>> = (0..47)
+            .map(|j| {
+                vec![
+                    ((j * 7919) % n, 1.0 + j as f64),
+                    ((j * 104_729 + 11) % n, -0.5),
+                ]
+            })
+            .collect();
+        let first: Vec<usize> = (0..n).filter(|&i| task(i) == 0).collect();
+        let one_task: Vec<Vec<(usize, f64)>> = (0..160)
+            .map(|j| vec![(first[(j * 7919) % first.len()], 1.0 + j as f64)])
+            .collect();
+        for (name, b) in [("spread", &spread), ("one task", &one_task)] {
+            let seq = tree.forward(&factor, b, &one, Par::Seq).unwrap();
+            if name == "one task" {
+                // A block of task 0 large enough to split.
+                assert!(seq.blocks.iter().any(|blk| {
+                    let rows = blk.rows
+                        + tree
+                            .block(factor.symbolic, factor.values, blk.block)
+                            .pattern
+                            .len();
+                    task_of[blk.block] == 0
+                        && rows * blk.rows * blk.columns.len() > super::PARALLEL_FLOPS
+                }));
+            }
+            let big = seq
+                .blocks
+                .iter()
+                .flat_map(|blk| &blk.values)
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            let par = tree.forward(&factor, b, &tasks, Par::rayon(2)).unwrap();
+            assert_eq!(par.blocks.len(), seq.blocks.len());
+            for (g, w) in par.blocks.iter().zip(&seq.blocks) {
+                assert_eq!((g.block, &g.columns), (w.block, &w.columns));
+                for (x, y) in g.values.iter().zip(&w.values) {
+                    assert!((x - y).abs() <= 1e-12 * big, "{name}: {x} vs {y}");
+                }
+            }
+        }
+    }
+
+    /// Loads within 10 % of an even share are balanced; one task with all of them is not.
+    #[test]
+    fn task_balance_rule() {
+        assert!(super::balanced(&[105, 95]));
+        assert!(!super::balanced(&[120, 80]));
+        assert!(!super::balanced(&[100, 0]));
+        assert!(super::balanced(&[]));
+    }
+
     #[test]
     fn sparse_forward_solve_with_columns_split_over_threads_matches_sequential() {
         use crate::block_solve::SolveSchedule;
