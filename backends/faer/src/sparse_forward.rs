@@ -566,7 +566,7 @@ pub(crate) mod tests {
     use super::{BlockTree, NONE};
     use crate::{CholeskyVariant, FaerCholesky};
     use faer::Par;
-    use fibercell_solver::{CscMatrix, LinearSolver, Ordering, SolverError};
+    use fibercell_solver::{CscMatrix, ForwardColumns, LinearSolver, Ordering, SolverError};
 
     /// The order, the matrix and the supernodal nested-dissection LLᵀ factor of `grid(k)`.
     pub(crate) fn grid_factor(k: usize) -> (usize, CscMatrix, FaerCholesky) {
@@ -712,23 +712,10 @@ pub(crate) mod tests {
                 "{threads} tasks: {reaching:?}"
             );
             let got = forward(&schedule);
-            assert_eq!(got.blocks.len(), one.blocks.len());
-            let big = one
-                .blocks
-                .iter()
-                .flat_map(|blk| &blk.values)
-                .fold(0.0f64, |m, v| m.max(v.abs()));
-            for (g, w) in got.blocks.iter().zip(&one.blocks) {
-                assert_eq!((g.block, &g.columns), (w.block, &w.columns));
-                for (x, y) in g.values.iter().zip(&w.values) {
-                    assert!((x - y).abs() <= 1e-12 * big, "{threads} tasks: {x} vs {y}");
-                }
-            }
+            assert_same_forward(&got, &one, &format!("{threads} tasks"));
         }
     }
 
-    /// Blocks large enough to split their columns over threads (the top separators of a 20³
-    /// grid with 47 columns) give the sequential result to 1e-12, on 2 and 3 threads.
     /// With the subtrees on two tasks and two threads the forward solve matches the
     /// sequential one, for columns spread over the cell and for columns all in one task's
     /// subtrees (unbalanced: that task's large blocks split over the threads).
@@ -768,18 +755,23 @@ pub(crate) mod tests {
                         && rows * blk.rows * blk.columns.len() > super::PARALLEL_FLOPS
                 }));
             }
-            let big = seq
-                .blocks
-                .iter()
-                .flat_map(|blk| &blk.values)
-                .fold(0.0f64, |m, v| m.max(v.abs()));
             let par = tree.forward(&factor, b, &tasks, Par::rayon(2)).unwrap();
-            assert_eq!(par.blocks.len(), seq.blocks.len());
-            for (g, w) in par.blocks.iter().zip(&seq.blocks) {
-                assert_eq!((g.block, &g.columns), (w.block, &w.columns));
-                for (x, y) in g.values.iter().zip(&w.values) {
-                    assert!((x - y).abs() <= 1e-12 * big, "{name}: {x} vs {y}");
-                }
+            assert_same_forward(&par, &seq, name);
+        }
+    }
+
+    /// `got` has the blocks and columns of `want`, values to 1e-12 of the largest.
+    fn assert_same_forward(got: &ForwardColumns, want: &ForwardColumns, label: &str) {
+        assert_eq!(got.blocks.len(), want.blocks.len(), "{label}");
+        let big = want
+            .blocks
+            .iter()
+            .flat_map(|blk| &blk.values)
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        for (g, w) in got.blocks.iter().zip(&want.blocks) {
+            assert_eq!((g.block, &g.columns), (w.block, &w.columns), "{label}");
+            for (x, y) in g.values.iter().zip(&w.values) {
+                assert!((x - y).abs() <= 1e-12 * big, "{label}: {x} vs {y}");
             }
         }
     }
@@ -793,6 +785,8 @@ pub(crate) mod tests {
         assert!(super::balanced(&[]));
     }
 
+    /// Blocks large enough to split their columns over threads (the top separators of a 20³
+    /// grid with 47 columns) give the sequential result to 1e-12, on 2 and 3 threads.
     #[test]
     fn sparse_forward_solve_with_columns_split_over_threads_matches_sequential() {
         use crate::block_solve::SolveSchedule;
@@ -818,24 +812,11 @@ pub(crate) mod tests {
                     .len();
             rows * blk.rows * blk.columns.len() > super::PARALLEL_FLOPS
         }));
-        let big = seq
-            .blocks
-            .iter()
-            .flat_map(|blk| &blk.values)
-            .fold(0.0f64, |m, v| m.max(v.abs()));
         for threads in [2, 3] {
             let par = tree
                 .forward(&factor, &b, &schedule, Par::rayon(threads))
                 .unwrap();
-            for (g, w) in par.blocks.iter().zip(&seq.blocks) {
-                assert_eq!((g.block, &g.columns), (w.block, &w.columns));
-                for (x, y) in g.values.iter().zip(&w.values) {
-                    assert!(
-                        (x - y).abs() <= 1e-12 * big,
-                        "{threads} threads: {x} vs {y}"
-                    );
-                }
-            }
+            assert_same_forward(&par, &seq, &format!("{threads} threads"));
         }
     }
 
