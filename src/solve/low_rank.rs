@@ -14,8 +14,8 @@
 
 use super::gram::new_gram_columns;
 use crate::contact::BlockCoefficients;
-use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::linalg::matmul::matmul;
+use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use fibercell_solver::{ForwardColumns, LinearSolver, SolverError};
 use nalgebra::Vector6;
