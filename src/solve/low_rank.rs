@@ -616,19 +616,21 @@ impl LowRankCorrection {
     fn forward_transpose(&self, f: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.columns.len()];
         if let ColumnMode::Forward(store) = &self.mode {
+            // One buffer for every block's products.
+            let mut products = Vec::new();
             for blk in store.values() {
                 let rows = &f[blk.first_row..blk.first_row + blk.rows];
-                let mut products = Mat::<f64>::zeros(blk.columns.len(), 1);
+                products.resize(blk.columns.len(), 0.0);
                 matmul(
-                    products.as_mut(),
+                    MatMut::from_column_major_slice_mut(&mut products, blk.columns.len(), 1),
                     Accum::Replace,
                     blk.matrix().transpose(),
                     MatRef::from_column_major_slice(rows, blk.rows, 1),
                     1.0,
                     blk.par(),
                 );
-                for (k, &c) in blk.columns.iter().enumerate() {
-                    out[c] += products[(k, 0)];
+                for (&c, p) in blk.columns.iter().zip(&products) {
+                    out[c] += p;
                 }
             }
         }
@@ -639,8 +641,11 @@ impl LowRankCorrection {
     /// solves.
     fn forward_spread(&self, v: &[f64], out: &mut [f64]) {
         if let ColumnMode::Forward(store) = &self.mode {
+            // One buffer for every block's coefficients.
+            let mut coefficients = Vec::new();
             for blk in store.values() {
-                let coefficients: Vec<f64> = blk.columns.iter().map(|&c| v[c]).collect();
+                coefficients.clear();
+                coefficients.extend(blk.columns.iter().map(|&c| v[c]));
                 if coefficients.iter().all(|&x| x == 0.0) {
                     continue;
                 }

@@ -236,6 +236,10 @@ impl LinearSolver for FaerCholesky {
             flops: Some(flops),
             ordering: name,
         };
+        let (factor_fwd, factor_inv) = match symbolic.perm() {
+            Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
+            None => ((0..n).collect(), (0..n).collect()),
+        };
         self.analysis = Some(Analysis {
             n,
             fingerprint: a.fingerprint(),
@@ -243,14 +247,8 @@ impl LinearSolver for FaerCholesky {
             perm,
             schedule: SolveSchedule::new(&tree, threads(self.par)),
             tree,
-            factor_fwd: match symbolic.perm() {
-                Some(p) => p.arrays().0.to_vec(),
-                None => (0..n).collect(),
-            },
-            factor_inv: match symbolic.perm() {
-                Some(p) => p.arrays().1.to_vec(),
-                None => (0..n).collect(),
-            },
+            factor_fwd,
+            factor_inv,
             symbolic,
         });
         Ok(info)

@@ -187,6 +187,15 @@ impl BlockTree {
             slot[s] = k;
         }
         let layouts = self.column_layouts(symbolic, columns, inv, &touched, &members, &slot);
+        // Per touched block: its columns in the order of its values.
+        let stored: Vec<Vec<usize>> = touched
+            .iter()
+            .zip(&layouts)
+            .map(|(&s, layout)| match layout {
+                Some(l) => l.order.iter().map(|&c| members[s][c]).collect(),
+                None => members[s].clone(),
+            })
+            .collect();
         let x_len: Vec<usize> = touched
             .iter()
             .map(|&s| self.shapes[s].width * members[s].len())
@@ -269,15 +278,7 @@ impl BlockTree {
             .iter()
             .map(|&k| self.shapes[touched[k]].width)
             .collect();
-        let storage: Vec<Vec<usize>> = lists[top]
-            .iter()
-            .map(|&k| {
-                let m = &members[touched[k]];
-                layouts[k]
-                    .as_ref()
-                    .map_or_else(|| m.clone(), |l| l.order.iter().map(|&c| m[c]).collect())
-            })
-            .collect();
+        let storage: Vec<&[usize]> = lists[top].iter().map(|&k| &stored[k][..]).collect();
         let (tasks, top_group) = groups.split_at_mut(top);
         let mut access = TopColumns::split(&mut top_group[0], &widths, &storage, &reached);
         tasks
@@ -299,15 +300,12 @@ impl BlockTree {
         let blocks = touched
             .iter()
             .zip(x)
-            .zip(&layouts)
-            .map(|((&s, values_s), layout)| ForwardBlock {
+            .zip(stored)
+            .map(|((&s, values_s), columns)| ForwardBlock {
                 block: s,
                 first_row: self.shapes[s].begin,
                 rows: self.shapes[s].width,
-                columns: match layout {
-                    Some(l) => l.order.iter().map(|&c| members[s][c]).collect(),
-                    None => std::mem::take(&mut members[s]),
-                },
+                columns,
                 values: values_s,
             })
             .collect();
@@ -729,14 +727,7 @@ pub(crate) mod tests {
         let tasks = SolveSchedule::with_threshold(&tree, 2, 0);
         let task_of = tasks.task_of(tree.parent.len());
         let task = |i: usize| task_of[tree.block_of[factor.inv[i]]];
-        let spread: Vec<Vec<(usize, f64)>> = (0..47)
-            .map(|j| {
-                vec![
-                    ((j * 7919) % n, 1.0 + j as f64),
-                    ((j * 104_729 + 11) % n, -0.5),
-                ]
-            })
-            .collect();
+        let spread = spread_columns(n);
         let first: Vec<usize> = (0..n).filter(|&i| task(i) == 0).collect();
         let one_task: Vec<Vec<(usize, f64)>> = (0..160)
             .map(|j| vec![(first[(j * 7919) % first.len()], 1.0 + j as f64)])
@@ -758,6 +749,18 @@ pub(crate) mod tests {
             let par = tree.forward(&factor, b, &tasks, Par::rayon(2)).unwrap();
             assert_same_forward(&par, &seq, name);
         }
+    }
+
+    /// 47 columns of two entries each, spread over the `n` rows.
+    fn spread_columns(n: usize) -> Vec<Vec<(usize, f64)>> {
+        (0..47)
+            .map(|j| {
+                vec![
+                    ((j * 7919) % n, 1.0 + j as f64),
+                    ((j * 104_729 + 11) % n, -0.5),
+                ]
+            })
+            .collect()
     }
 
     /// `got` has the blocks and columns of `want`, values to 1e-12 of the largest.
@@ -793,14 +796,7 @@ pub(crate) mod tests {
         let (n, _, s) = grid_factor(20);
         let factor = s.factor_view();
         let tree = BlockTree::of(factor.symbolic);
-        let b: Vec<Vec<(usize, f64)>> = (0..47)
-            .map(|j| {
-                vec![
-                    ((j * 7919) % n, 1.0 + j as f64),
-                    ((j * 104_729 + 11) % n, -0.5),
-                ]
-            })
-            .collect();
+        let b = spread_columns(n);
         let schedule = SolveSchedule::with_threshold(&tree, 1, 0);
         let seq = tree.forward(&factor, &b, &schedule, Par::Seq).unwrap();
         // The split must happen somewhere: a block of at least 2²⁰ products.

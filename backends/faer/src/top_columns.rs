@@ -46,7 +46,7 @@ impl<'a> TopColumns<'a> {
     pub(crate) fn split(
         top: &'a mut [Vec<f64>],
         widths: &[usize],
-        storage: &[Vec<usize>],
+        storage: &[&[usize]],
         reached: &[Vec<bool>],
     ) -> Vec<TopColumns<'a>> {
         let columns = reached.first().map_or(0, Vec::len);
@@ -147,7 +147,7 @@ mod tests {
     #[test]
     fn first_task_owns_a_column_and_later_ones_add_privately() {
         let mut top = vec![vec![1.0; 6]];
-        let storage = vec![vec![4, 0, 2]];
+        let storage: [&[usize]; 1] = [&[4, 0, 2]];
         let mut reached = vec![vec![false; 5]; 2];
         reached[0][0] = true;
         reached[0][4] = true;
@@ -170,7 +170,7 @@ mod tests {
     fn a_column_the_task_does_not_reach_is_refused() {
         let mut top = vec![vec![0.0; 4]];
         let reached = vec![vec![true, false], vec![false, true]];
-        let mut tasks = TopColumns::split(&mut top, &[2], &[vec![0, 1]], &reached);
+        let mut tasks = TopColumns::split(&mut top, &[2], &[&[0, 1]], &reached);
         tasks[1].column(0, 0);
     }
 }
