@@ -132,9 +132,10 @@ pub struct ReuseBench {
     /// changed within them: the LU and one solve, from A₀⁻¹ b₀ known (s; median).
     #[serde(default)]
     pub low_rank_next_seconds: Option<f64>,
-    /// The first low-rank solve's stages (s): the new columns of S (sparse forward solves),
-    /// the capacitance factorization, and the solve (a forward and a backward half with A₀'s
-    /// factor, the products with W, the capacitance solve), of the median run. Absent in
+    /// The first low-rank solve's stages (s): the new columns of S (sparse forward solves,
+    /// with the right-hand side's forward half along since reports of 2026-11-25; before, in
+    /// the solve), the capacitance factorization, and the solve (the products with W, the
+    /// capacitance solve and a backward half with A₀'s factor), of the median run. Absent in
     /// reports written before.
     #[serde(default)]
     pub low_rank_stages: Option<[f64; 3]>,
@@ -356,9 +357,9 @@ fn bench_backend(
 
 /// The contacts `list` switched stick → sliding as the low-rank correction A₀ − W Wᵀ (W their
 /// stick-spring columns, E = −I) of the factorization `a0` of the unswitched matrix: seconds of
-/// the first solve (columns, LU, two solves) and its stages (columns, capacitance, solve) from
-/// the run of median total among `repeats` (at least [`LOW_RANK_REPEATS`], each from no
-/// columns), the median seconds of the next solve on the same columns with the load changed
+/// the first solve (columns with the right-hand side's forward half, LU, a backward half) and
+/// its stages (columns, capacitance, solve) from the run of median total among `repeats` (at
+/// least [`LOW_RANK_REPEATS`], each from no columns), the median seconds of the next solve on the same columns with the load changed
 /// within them (LU, one solve), and the first solves' largest backward error on the switched
 /// matrix `a`.
 fn low_rank_switch(
@@ -392,11 +393,12 @@ fn low_rank_switch(
     for _ in 0..repeats.max(LOW_RANK_REPEATS) {
         let mut low_rank = LowRankCorrection::new(a.ncols(), list.len());
         let t = Instant::now();
-        low_rank.extend(a0, &changes, column)?;
+        // The columns' forward solves take the right-hand side's forward half along.
+        let reference = low_rank.extend_with_reference(a0, &changes, column, |_| rhs.to_vec())?;
         let columns = t.elapsed().as_secs_f64();
         let cap = low_rank.capacitance(&changes);
         let capacitance = t.elapsed().as_secs_f64() - columns;
-        let x = low_rank.solve(a0, &cap, rhs)?;
+        let x = low_rank.solve_from_taken(a0, &cap, reference, &vec![0.0; cap.order()])?;
         let first = t.elapsed().as_secs_f64();
         firsts.push((first, [columns, capacitance, first - columns - capacitance]));
         error = error.max(backward_error(a, &x, rhs));

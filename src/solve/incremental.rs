@@ -1273,11 +1273,24 @@ pub(crate) fn run_incremental(
                 if low_rank.len() + new > opts.max_low_rank_columns {
                     refresh_reference = true;
                 } else if affordable {
-                    low_rank
-                        .extend(a0.as_mut(), changes, |c, k| {
-                            low_rank_column(&pairs[c], disc, k)
-                        })
-                        .map_err(locate)?;
+                    let column = |c: usize, k: usize| low_rank_column(&pairs[c], disc, k);
+                    let x0 = match reference_solution.take() {
+                        Some(x0) => {
+                            low_rank
+                                .extend(a0.as_mut(), changes, column)
+                                .map_err(locate)?;
+                            x0
+                        }
+                        // b₀ = b − U Δχ, the load with every contact as in the reference; its
+                        // forward half along with the new columns' forward solves.
+                        None => low_rank
+                            .extend_with_reference(a0.as_mut(), changes, column, |low_rank| {
+                                let load = low_rank.active_load(changes);
+                                let shift = low_rank.spread(changes, &load);
+                                rhs.iter().zip(&shift).map(|(b, s)| b - s).collect()
+                            })
+                            .map_err(locate)?,
+                    };
                     let started = std::time::Instant::now();
                     let cap = low_rank.capacitance(changes);
                     if order > 0 {
@@ -1286,15 +1299,6 @@ pub(crate) fn run_incremental(
                         .max(1e8);
                     }
                     let load = low_rank.active_load(changes);
-                    let x0 = match reference_solution.take() {
-                        Some(x0) => x0,
-                        None => {
-                            // b₀ = b − U Δχ, the load with every contact as in the reference.
-                            let shift = low_rank.spread(&cap, &load);
-                            let b0: Vec<f64> = rhs.iter().zip(&shift).map(|(b, s)| b - s).collect();
-                            low_rank.reference(a0.as_mut(), b0).map_err(locate)?
-                        }
-                    };
                     let first = low_rank.solve_from(a0.as_mut(), &cap, &x0, &load);
                     reference_solution = Some(x0);
                     match first {

@@ -230,6 +230,37 @@ impl LowRankCorrection {
         changes: &[ContactChange],
         column: impl Fn(usize, usize) -> SparseColumn + Sync,
     ) -> Result<(), SolverError> {
+        let first = self.add_columns(changes, column);
+        self.solve_columns(a0, first, None).map(|_| ())
+    }
+
+    /// [`LowRankCorrection::extend`], and the [`Reference`] of the right-hand side `b0(self)`
+    /// (called once the new columns are there, e.g. to take U Δχ off the load): with S from
+    /// forward solves, b₀'s forward half goes through the factor along with the first new
+    /// columns, each block of L read once for both.
+    pub(crate) fn extend_with_reference(
+        &mut self,
+        a0: &mut dyn LinearSolver,
+        changes: &[ContactChange],
+        column: impl Fn(usize, usize) -> SparseColumn + Sync,
+        b0: impl FnOnce(&Self) -> Vec<f64>,
+    ) -> Result<Reference, SolverError> {
+        let first = self.add_columns(changes, column);
+        let mut b = b0(self);
+        if self.solve_columns(a0, first, Some(&mut b))? {
+            Ok(Reference::Forward(b))
+        } else {
+            self.reference(a0, b)
+        }
+    }
+
+    /// Adds the columns `changes` need (see [`LowRankCorrection::extend`]); the index of the
+    /// first new one.
+    fn add_columns(
+        &mut self,
+        changes: &[ContactChange],
+        column: impl Fn(usize, usize) -> SparseColumn + Sync,
+    ) -> usize {
         let first = self.columns.len();
         let wanted: Vec<(usize, usize)> = changes
             .iter()
@@ -238,22 +269,46 @@ impl LowRankCorrection {
                 (have..ch.columns_needed().max(have)).map(move |k| (c, ORDER[k]))
             })
             .collect();
-        let batch = self.batch();
-        if wanted.is_empty() {
-            return Ok(());
-        }
         let new: Vec<SparseColumn> = wanted.par_iter().map(|&(c, k)| column(c, k)).collect();
         for (j, &(c, _)) in wanted.iter().enumerate() {
             self.owned[c].push(first + j);
         }
         self.columns.extend(new);
+        first
+    }
+
+    /// Extends S by the columns `first..`; with `rhs`, also its forward half in place when
+    /// it could go along with the columns' forward solves (then `true`).
+    fn solve_columns(
+        &mut self,
+        a0: &mut dyn LinearSolver,
+        first: usize,
+        mut rhs: Option<&mut Vec<f64>>,
+    ) -> Result<bool, SolverError> {
         let total = self.columns.len();
+        if first == total {
+            return Ok(false);
+        }
+        let batch = self.batch();
         let n = self.n;
         self.s.resize_with(total, total, |_, _| 0.0);
+        let mut fused = false;
         if !matches!(self.mode, ColumnMode::Solves) {
             for start in (first..total).step_by(FORWARD_BATCH) {
                 let end = (start + FORWARD_BATCH).min(total);
-                match a0.forward_solve_sparse(&self.columns[start..end]) {
+                let columns = &self.columns[start..end];
+                let w = match rhs.take() {
+                    // A backend that cannot go along falls back to the columns alone.
+                    Some(x) => match a0.forward_solve_sparse_and_lower(columns, x) {
+                        Err(SolverError::Unavailable { .. }) => a0.forward_solve_sparse(columns),
+                        w => {
+                            fused = w.is_ok();
+                            w
+                        }
+                    },
+                    None => a0.forward_solve_sparse(columns),
+                };
+                match w {
                     Ok(w) => self.add_forward(start, w),
                     Err(SolverError::Unavailable { .. })
                         if matches!(self.mode, ColumnMode::Unknown) =>
@@ -265,7 +320,7 @@ impl LowRankCorrection {
                 }
             }
             if !matches!(self.mode, ColumnMode::Solves) {
-                return Ok(());
+                return Ok(fused);
             }
         }
         for start in (first..total).step_by(batch) {
@@ -294,7 +349,7 @@ impl LowRankCorrection {
                 }
             }
         }
-        Ok(())
+        Ok(false)
     }
 
     /// Adds S's entries for the columns `start..` from their forward solves `w`:
@@ -469,10 +524,12 @@ impl LowRankCorrection {
             .collect()
     }
 
-    /// U v for `v` on the columns of `cap`.
-    pub(crate) fn spread(&self, cap: &Capacitance, v: &[f64]) -> Vec<f64> {
+    /// U v for `v` on the columns of `changes` (in the order of
+    /// [`LowRankCorrection::active_load`] and of their capacitance).
+    pub(crate) fn spread(&self, changes: &[ContactChange], v: &[f64]) -> Vec<f64> {
         let mut w = vec![0.0; self.n];
-        for (&col, vj) in cap.active.iter().zip(v) {
+        let active = changes.iter().flat_map(|ch| &self.owned[ch.contact]);
+        for (&col, vj) in active.zip(v) {
             for &(i, u) in &self.columns[col] {
                 w[i] += u * vj;
             }
@@ -490,9 +547,20 @@ impl LowRankCorrection {
         b: &[f64],
     ) -> Result<Vec<f64>, SolverError> {
         let reference = self.reference(a0, b.to_vec())?;
-        let v = self.coefficients(cap, &reference, &vec![0.0; cap.order()])?;
+        self.solve_from_taken(a0, cap, reference, &vec![0.0; cap.order()])
+    }
+
+    /// [`LowRankCorrection::solve_from`] when `reference` is not needed afterwards: a forward
+    /// half is taken, and the backward half runs in place on it.
+    pub(crate) fn solve_from_taken(
+        &self,
+        a0: &mut dyn LinearSolver,
+        cap: &Capacitance,
+        reference: Reference,
+        load: &[f64],
+    ) -> Result<Vec<f64>, SolverError> {
+        let v = self.coefficients(cap, &reference, load)?;
         match reference {
-            // The forward half is not needed afterwards: the backward half runs in place.
             Reference::Forward(f) => self.backward_from(a0, f, &v),
             full => self.finish(a0, &full, &v),
         }
@@ -869,7 +937,7 @@ mod tests {
         // From x₀ = A₀⁻¹ b₀ and b = b₀ + U Δχ with one solve.
         let load = low_rank.active_load(&changes);
         assert_eq!(load.len(), 11);
-        let spread = low_rank.spread(&cap, &load);
+        let spread = low_rank.spread(&changes, &load);
         let b1: Vec<f64> = b.iter().zip(&spread).map(|(p, q)| p + q).collect();
         let mut x0 = b.clone();
         solver.solve_in_place(&mut x0, 1).expect("solve");
@@ -883,6 +951,28 @@ mod tests {
             .reference(solver.as_mut(), b.clone())
             .expect("solve");
         assert_eq!(matches!(kept, Reference::Forward(_)), forward);
+        // The same columns with b₀'s reference taken along (fused with the forward solves
+        // where S comes from them): the same S and reference, to 1e-12.
+        let mut along = LowRankCorrection::new(n, 4);
+        along
+            .extend(solver.as_mut(), &first, column)
+            .expect("extend");
+        let taken = along
+            .extend_with_reference(solver.as_mut(), &changes, column, |lr| {
+                assert_eq!(lr.len(), 11, "the new columns are there");
+                b.clone()
+            })
+            .expect("extend");
+        let scale = low_rank.s.norm_max();
+        assert!((&along.s - &low_rank.s).norm_max() <= 1e-12 * scale);
+        match (&taken, &kept) {
+            (Reference::Forward(p), Reference::Forward(q))
+            | (Reference::Full(p), Reference::Full(q)) => {
+                let big = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                assert!(p.iter().zip(q).all(|(x, y)| (x - y).abs() <= 1e-12 * big));
+            }
+            _ => panic!("{kind:?}: references of different kinds"),
+        }
         for reference in [Reference::Full(x0), kept] {
             let x1 = low_rank
                 .solve_from(solver.as_mut(), &cap, &reference, &load)

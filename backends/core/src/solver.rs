@@ -94,6 +94,20 @@ pub trait LinearSolver: Send {
         })
     }
 
+    /// [`LinearSolver::forward_solve_sparse`] for `columns` together with the forward half of
+    /// one dense right-hand side, `x` ← L⁻¹ P Ŝ x as [`LinearSolver::solve_lower_in_place`]:
+    /// a backend may read each block of L once for both (a low-rank solve's new columns and
+    /// its right-hand side). `x` is left as it was on an error. Default: the two in turn.
+    fn forward_solve_sparse_and_lower(
+        &mut self,
+        columns: &[Vec<(usize, f64)>],
+        x: &mut [f64],
+    ) -> Result<ForwardColumns, SolverError> {
+        let w = self.forward_solve_sparse(columns)?;
+        self.solve_lower_in_place(x)?;
+        Ok(w)
+    }
+
     /// The forward half of a solve with the symmetric factorization A = Ŝ⁻¹ Pᵀ L Lᵀ P Ŝ⁻¹ for
     /// one right-hand side: `x` ← L⁻¹ P Ŝ x, in the factor's row order (see
     /// [`LinearSolver::solve_upper_in_place`]; the same space as

@@ -7,6 +7,7 @@
 //! their updates of the top rows privately (summed afterwards), then the top blocks follow;
 //! backward, the top blocks first, then the subtrees in parallel (they only read the top rows).
 
+use crate::dense_forward::DenseForward;
 use crate::sparse_forward::{Block, BlockTree, NONE};
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
@@ -62,6 +63,27 @@ impl SolveSchedule {
     /// The number of tasks (threads) the subtrees are split into; 0 when not parallel.
     pub(crate) fn task_count(&self) -> usize {
         self.tasks.len()
+    }
+
+    /// Per task: the blocks of its subtrees, ascending.
+    pub(crate) fn task_blocks(&self) -> &[Vec<usize>] {
+        &self.tasks
+    }
+
+    /// The top blocks (every block when not parallel), ascending.
+    pub(crate) fn top_blocks(&self) -> &[usize] {
+        &self.top
+    }
+
+    /// Per column of L: its index among the top blocks' columns, or `NONE` (empty when not
+    /// parallel).
+    pub(crate) fn top_index(&self) -> &[usize] {
+        &self.top_index
+    }
+
+    /// Columns in the top blocks (0 when not parallel).
+    pub(crate) fn top_rows(&self) -> usize {
+        self.top_rows
     }
 
     /// Balances the subtrees of `tree` over `threads` by the number of factor values.
@@ -166,14 +188,14 @@ fn assign_longest_first(
 
 /// The solution vector shared by the threads, each writing its own rows only.
 #[derive(Clone, Copy)]
-struct Shared(*mut f64);
-// SAFETY: the threads of `solve_in_place` touch disjoint rows (see there).
+pub(crate) struct Shared(pub(crate) *mut f64);
+// SAFETY: the threads of the solves touch disjoint rows (see there).
 unsafe impl Send for Shared {}
 unsafe impl Sync for Shared {}
 
 impl Shared {
     /// Pointer to row `i` (a method, so closures capture the `Send` wrapper).
-    fn at(self, i: usize) -> *mut f64 {
+    pub(crate) fn at(self, i: usize) -> *mut f64 {
         self.0.wrapping_add(i)
     }
 }
@@ -198,7 +220,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// Forward elimination of one block: its rows `top` solved in place, `below` set to what its
 /// pattern rows lose.
-fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>, par: Par) {
+pub(crate) fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>, par: Par) {
     let ld = b.width + b.pattern.len();
     below.clear();
     below.resize(b.pattern.len(), 0.0);
@@ -258,7 +280,7 @@ fn backward_block(b: &Block<'_>, top: &mut [f64], below: &[f64], par: Par) {
 
 /// The threads of a top block's kernels: those of `schedule` for the largest blocks (each
 /// read once per solve, bandwidth-bound on one core).
-fn top_par(b: &Block<'_>, schedule: &SolveSchedule) -> Par {
+pub(crate) fn top_par(b: &Block<'_>, schedule: &SolveSchedule) -> Par {
     let threads = schedule.task_count();
     if threads > 1 && b.values.len() >= PARALLEL_BLOCK_VALUES {
         Par::rayon(threads)
@@ -287,55 +309,7 @@ pub(crate) fn forward_in_place(
     values: &[f64],
     x: &mut [f64],
 ) {
-    let shared = Shared(x.as_mut_ptr());
-    let top_index = &schedule.top_index;
-    // Forward: the subtrees, their updates of top rows kept per thread.
-    let updates: Vec<Vec<f64>> = schedule
-        .tasks
-        .par_iter()
-        .map(|blocks| {
-            let mut update = vec![0.0; schedule.top_rows];
-            let mut below = Vec::new();
-            for &s in blocks {
-                let b = tree.block(symbolic, values, s);
-                // SAFETY: a block's rows and the rows below it that are not top rows lie in
-                // this task's subtrees, which no other task touches; top rows go to `update`.
-                let top = unsafe { std::slice::from_raw_parts_mut(shared.at(b.begin), b.width) };
-                forward_block(&b, top, &mut below, Par::Seq);
-                for (&row, t) in b.pattern.iter().zip(&below) {
-                    match top_index[row] {
-                        NONE => unsafe { *shared.at(row) -= t },
-                        k => update[k] -= t,
-                    }
-                }
-            }
-            update
-        })
-        .collect();
-    let mut below = Vec::new();
-    for update in &updates {
-        for &s in &schedule.top {
-            let b = &tree.shapes[s];
-            for (xi, &k) in x[b.begin..b.begin + b.width]
-                .iter_mut()
-                .zip(&top_index[b.begin..b.begin + b.width])
-            {
-                *xi += update[k];
-            }
-        }
-    }
-    for &s in &schedule.top {
-        let b = tree.block(symbolic, values, s);
-        forward_block(
-            &b,
-            &mut x[b.begin..b.begin + b.width],
-            &mut below,
-            top_par(&b, schedule),
-        );
-        for (&row, t) in b.pattern.iter().zip(&below) {
-            x[row] -= t;
-        }
-    }
+    DenseForward::new(tree, schedule, symbolic, values, x).run();
 }
 
 /// x ← L⁻ᵀ x (factor order): the top blocks, then the subtrees (reading the final top rows).

@@ -139,6 +139,27 @@ impl FaerCholesky {
         Ok((an, f))
     }
 
+    /// `x` ← L⁻¹ P Ŝ x by `forward` on x in the factor's order (in the solver's work buffer),
+    /// which may compute more; `x` is left as it was when `forward` fails.
+    fn lower_half<T>(
+        &mut self,
+        x: &mut [f64],
+        forward: impl FnOnce(&Analysis, &Factor, &mut [f64]) -> Result<T, SolverError>,
+    ) -> Result<T, SolverError> {
+        let mut y = std::mem::take(&mut self.work);
+        let (an, f) = self.llt_parts()?;
+        <dyn LinearSolver>::check_rhs(an.n, x, 1)?;
+        let parallel = an.schedule.is_parallel();
+        y.resize(an.n, 0.0);
+        permute::into_factor_order(x, &f.scale, &an.factor_fwd, &mut y, parallel);
+        let out = forward(an, f, &mut y);
+        if out.is_ok() {
+            permute::copy(&y, x, parallel);
+        }
+        self.work = y;
+        out
+    }
+
     /// Runs single-threaded.
     pub fn sequential(mut self) -> Self {
         self.par = Par::Seq;
@@ -409,16 +430,10 @@ impl LinearSolver for FaerCholesky {
     }
 
     fn solve_lower_in_place(&mut self, x: &mut [f64]) -> Result<(), SolverError> {
-        let mut y = std::mem::take(&mut self.work);
-        let (an, f) = self.llt_parts()?;
-        <dyn LinearSolver>::check_rhs(an.n, x, 1)?;
-        let parallel = an.schedule.is_parallel();
-        y.resize(an.n, 0.0);
-        permute::into_factor_order(x, &f.scale, &an.factor_fwd, &mut y, parallel);
-        forward_in_place(&an.tree, &an.schedule, &an.symbolic, &f.l_values, &mut y);
-        permute::copy(&y, x, parallel);
-        self.work = y;
-        Ok(())
+        self.lower_half(x, |an, f, y| {
+            forward_in_place(&an.tree, &an.schedule, &an.symbolic, &f.l_values, y);
+            Ok(())
+        })
     }
 
     fn solve_upper_in_place(&mut self, y: &mut [f64]) -> Result<(), SolverError> {
@@ -440,6 +455,19 @@ impl LinearSolver for FaerCholesky {
     ) -> Result<ForwardColumns, SolverError> {
         let (an, f) = self.llt_parts()?;
         an.tree
-            .forward(&factor_view(an, f), columns, &an.schedule, self.par)
+            .forward(&factor_view(an, f), columns, &an.schedule, self.par, None)
+    }
+
+    fn forward_solve_sparse_and_lower(
+        &mut self,
+        columns: &[Vec<(usize, f64)>],
+        x: &mut [f64],
+    ) -> Result<ForwardColumns, SolverError> {
+        let par = self.par;
+        self.lower_half(x, |an, f, y| {
+            let factor = factor_view(an, f);
+            an.tree
+                .forward(&factor, columns, &an.schedule, par, Some(y))
+        })
     }
 }

@@ -5,6 +5,7 @@
 mod block_solve;
 mod cholesky;
 mod column_layout;
+mod dense_forward;
 mod lu;
 mod permute;
 mod pivots;

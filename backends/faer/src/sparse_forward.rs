@@ -3,6 +3,7 @@
 
 use crate::block_solve::SolveSchedule;
 use crate::column_layout::ColumnLayout;
+use crate::dense_forward::{DenseForward, ForwardCursor};
 use crate::top_columns::TopColumns;
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
@@ -145,13 +146,16 @@ impl BlockTree {
     }
 
     /// W = L⁻¹ P Ŝ B for the sparse columns `columns` (original row numbering) on `factor`,
-    /// the subtrees of `schedule` on separate threads.
+    /// the subtrees of `schedule` on separate threads; with `rhs` (factor order) also its
+    /// forward half `rhs` ← L⁻¹ `rhs`, each block the columns read eliminated for it right
+    /// after them (while in cache), the other blocks in between.
     pub(crate) fn forward(
         &self,
         factor: &FactorView<'_>,
         columns: &[Vec<(usize, f64)>],
         schedule: &SolveSchedule,
         par: Par,
+        rhs: Option<&mut [f64]>,
     ) -> Result<ForwardColumns, SolverError> {
         let FactorView {
             symbolic,
@@ -281,17 +285,32 @@ impl BlockTree {
         let storage: Vec<&[usize]> = lists[top].iter().map(|&k| &stored[k][..]).collect();
         let (tasks, top_group) = groups.split_at_mut(top);
         let mut access = TopColumns::split(&mut top_group[0], &widths, &storage, &reached);
+        let mut dense = rhs.map(|x| DenseForward::new(self, schedule, symbolic, values, x));
+        let mut cursors: Vec<Option<ForwardCursor<'_>>> = match dense.as_mut() {
+            Some(d) => d.task_cursors().into_iter().map(Some).collect(),
+            None => (0..top).map(|_| None).collect(),
+        };
         tasks
             .par_iter_mut()
             .zip(&lists[..top])
             .zip(access.par_iter_mut())
+            .zip(cursors.par_iter_mut())
             .enumerate()
-            .for_each(|(g, ((mine, list), target))| {
-                walk.eliminate(g, list, mine, Some(target));
+            .for_each(|(g, (((mine, list), target), cursor))| {
+                walk.eliminate(g, list, mine, Some(target), cursor.as_mut());
             });
+        let updates: Vec<Vec<f64>> = cursors
+            .into_iter()
+            .flatten()
+            .map(ForwardCursor::into_updates)
+            .collect();
         TopColumns::join(access);
         let top_xs = &mut top_group[0];
-        walk.eliminate(top, &lists[top], top_xs, None);
+        let mut top_cursor = dense.as_mut().map(|d| {
+            d.add_updates(&updates);
+            d.top_cursor()
+        });
+        walk.eliminate(top, &lists[top], top_xs, None, top_cursor.as_mut());
         for (list, group) in lists.iter().zip(groups) {
             for (&k, xk) in list.iter().zip(group) {
                 x[k] = xk;
@@ -412,18 +431,24 @@ impl Walk<'_> {
     /// Eliminates the touched blocks `list` of group `group` (ascending), their solutions
     /// `mine` (in list order): each block's rows solved, its rows below subtracted from its
     /// ancestors' — in `mine`, or for top blocks of another group through `top_columns` (by
-    /// their position among the top blocks).
+    /// their position among the top blocks). A dense right-hand side's `cursor` over the
+    /// group's blocks advances alongside: to each touched block before it, past it right
+    /// after its columns are solved, and to the group's end.
     fn eliminate(
         &self,
         group: usize,
         list: &[usize],
         mine: &mut [Vec<f64>],
         mut top_columns: Option<&mut TopColumns<'_>>,
+        mut cursor: Option<&mut ForwardCursor<'_>>,
     ) {
         let mut below = Vec::new();
         let mut position = Vec::new();
         for (i, &k) in list.iter().enumerate() {
             let s = self.touched[k];
+            if let Some(c) = cursor.as_deref_mut() {
+                c.advance_to(s);
+            }
             let b = self.tree.block(self.symbolic, self.values, s);
             let m = self.members[s].len();
             let rows = b.width + b.pattern.len();
@@ -497,6 +522,9 @@ impl Walk<'_> {
                     .into_iter()
                     .for_each(|(x, out, low)| solve(x, out, low));
             }
+            if let Some(c) = cursor.as_deref_mut() {
+                c.advance_to(s + 1);
+            }
             if b.pattern.is_empty() {
                 continue;
             }
@@ -555,6 +583,9 @@ impl Walk<'_> {
                 }
                 r0 = r1;
             }
+        }
+        if let Some(c) = cursor {
+            c.finish();
         }
     }
 }
@@ -684,7 +715,7 @@ pub(crate) mod tests {
         let tree = BlockTree::of(factor.symbolic);
         let b = columns(n);
         let forward =
-            |schedule: &SolveSchedule| tree.forward(&factor, &b, schedule, Par::Seq).unwrap();
+            |schedule: &SolveSchedule| tree.forward(&factor, &b, schedule, Par::Seq, None).unwrap();
         let one = forward(&SolveSchedule::with_threshold(&tree, 1, 0));
         for threads in [2, 3] {
             let schedule = SolveSchedule::with_threshold(&tree, threads, 0);
@@ -733,7 +764,7 @@ pub(crate) mod tests {
             .map(|j| vec![(first[(j * 7919) % first.len()], 1.0 + j as f64)])
             .collect();
         for (name, b) in [("spread", &spread), ("one task", &one_task)] {
-            let seq = tree.forward(&factor, b, &one, Par::Seq).unwrap();
+            let seq = tree.forward(&factor, b, &one, Par::Seq, None).unwrap();
             if name == "one task" {
                 // A block of task 0 large enough to split.
                 assert!(seq.blocks.iter().any(|blk| {
@@ -746,7 +777,9 @@ pub(crate) mod tests {
                         && rows * blk.rows * blk.columns.len() > super::PARALLEL_FLOPS
                 }));
             }
-            let par = tree.forward(&factor, b, &tasks, Par::rayon(2)).unwrap();
+            let par = tree
+                .forward(&factor, b, &tasks, Par::rayon(2), None)
+                .unwrap();
             assert_same_forward(&par, &seq, name);
         }
     }
@@ -779,6 +812,54 @@ pub(crate) mod tests {
         }
     }
 
+    /// The forward half of a dense right-hand side taken along with sparse columns is the
+    /// plain forward half bit for bit (the same block operations in the same order), and the
+    /// columns' values are as without it: on one group, on 2 and 3 subtree tasks (sequential
+    /// and on two threads), with no columns, and through the trait, whose error on a bad
+    /// column leaves the right-hand side as it was.
+    #[test]
+    fn forward_solve_with_a_dense_right_hand_side_matches_the_two_apart() {
+        use crate::block_solve::{forward_in_place, SolveSchedule};
+        let (n, _, mut s) = grid_factor(20);
+        let b = spread_columns(n);
+        let rhs: Vec<f64> = (0..n).map(|i| ((i * 37) % 23) as f64 - 11.0).collect();
+        {
+            let factor = s.factor_view();
+            let tree = BlockTree::of(factor.symbolic);
+            for threads in [1, 2, 3] {
+                let schedule = SolveSchedule::with_threshold(&tree, threads, 0);
+                let mut want = rhs.clone();
+                forward_in_place(&tree, &schedule, factor.symbolic, factor.values, &mut want);
+                for par in [Par::Seq, Par::rayon(2)] {
+                    let label = format!("{threads} tasks, {par:?}");
+                    let alone = tree.forward(&factor, &b, &schedule, par, None).unwrap();
+                    for columns in [&b[..], &[]] {
+                        let mut x = rhs.clone();
+                        let w = tree
+                            .forward(&factor, columns, &schedule, par, Some(&mut x))
+                            .unwrap();
+                        assert!(x == want, "{label}, {} columns", columns.len());
+                        if columns.is_empty() {
+                            assert!(w.blocks.is_empty());
+                        } else {
+                            assert_same_forward(&w, &alone, &label);
+                        }
+                    }
+                }
+            }
+        }
+        let mut want = rhs.clone();
+        s.solve_lower_in_place(&mut want).unwrap();
+        let mut x = rhs.clone();
+        let w = s.forward_solve_sparse_and_lower(&b, &mut x).unwrap();
+        assert!(x == want);
+        assert_same_forward(&w, &s.forward_solve_sparse(&b).unwrap(), "trait");
+        let mut x = rhs.clone();
+        let bad = s.forward_solve_sparse_and_lower(&[vec![(n, 1.0)]], &mut x);
+        assert!(matches!(bad, Err(SolverError::DimensionMismatch(_))));
+        assert!(x == rhs);
+    }
+
     /// Loads within 10 % of an even share are balanced; one task with all of them is not.
     #[test]
     fn task_balance_rule() {
@@ -798,7 +879,9 @@ pub(crate) mod tests {
         let tree = BlockTree::of(factor.symbolic);
         let b = spread_columns(n);
         let schedule = SolveSchedule::with_threshold(&tree, 1, 0);
-        let seq = tree.forward(&factor, &b, &schedule, Par::Seq).unwrap();
+        let seq = tree
+            .forward(&factor, &b, &schedule, Par::Seq, None)
+            .unwrap();
         // The split must happen somewhere: a block of at least 2²⁰ products.
         assert!(seq.blocks.iter().any(|blk| {
             let rows = tree.shapes[blk.block].width
@@ -810,7 +893,7 @@ pub(crate) mod tests {
         }));
         for threads in [2, 3] {
             let par = tree
-                .forward(&factor, &b, &schedule, Par::rayon(threads))
+                .forward(&factor, &b, &schedule, Par::rayon(threads), None)
                 .unwrap();
             assert_same_forward(&par, &seq, &format!("{threads} threads"));
         }
@@ -871,7 +954,7 @@ pub(crate) mod tests {
         let tree = BlockTree::of(factor.symbolic);
         let schedule = SolveSchedule::with_threshold(&tree, 2, 0);
         for par in [Par::Seq, Par::rayon(2)] {
-            let w = tree.forward(&factor, &b, &schedule, par).unwrap();
+            let w = tree.forward(&factor, &b, &schedule, par, None).unwrap();
             assert!(
                 w.blocks
                     .iter()
