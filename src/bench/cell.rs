@@ -94,8 +94,11 @@ pub struct ReuseBench {
     /// Its cost relative to faer's refactorization plus solve (`refactorization_seconds`).
     pub ratio_to_refactorization: f64,
     /// The denominator of the faer ratios: a numeric refactorization plus one solve on the
-    /// same solver, the median of at least three after a first (s). Absent in reports written
-    /// before, whose ratios divided by the first factorization of a fresh solver.
+    /// same solver (s). Since reports of 2026-11-25 the median of those timed one right before
+    /// each of the row's low-rank first solves (paired, so that the VM's speed drifting
+    /// between stages does not enter the ratios); before, the median of at least three after
+    /// a first, once for all rows. Absent in reports written before that, whose ratios divided
+    /// by the first factorization of a fresh solver.
     #[serde(default)]
     pub refactorization_seconds: Option<f64>,
     /// The same for CHOLMOD, the denominator of its ratios (s). Absent without the cholmod
@@ -160,12 +163,23 @@ fn refactorization(
     rhs: &[f64],
     repeats: usize,
 ) -> Result<f64, Error> {
-    let (seconds, _) = median_of(repeats.max(3), || {
-        solver.factorize(a)?;
-        let mut x = rhs.to_vec();
-        Ok(solver.solve_in_place(&mut x, 1)?)
-    })?;
-    Ok(seconds)
+    let times = (0..repeats.max(3))
+        .map(|_| refactorize_once(solver, a, rhs))
+        .collect::<Result<Vec<f64>, Error>>()?;
+    Ok(median(times))
+}
+
+/// Seconds of one numeric refactorization of `a` plus one solve of `rhs` on `solver`.
+fn refactorize_once(
+    solver: &mut dyn fibercell_solver::LinearSolver,
+    a: CscRef<'_>,
+    rhs: &[f64],
+) -> Result<f64, Error> {
+    let t = Instant::now();
+    solver.factorize(a)?;
+    let mut x = rhs.to_vec();
+    solver.solve_in_place(&mut x, 1)?;
+    Ok(t.elapsed().as_secs_f64())
 }
 
 /// CHOLMOD (when built with it) factorized on the unswitched matrix `a0`, with its
@@ -356,15 +370,18 @@ fn bench_backend(
 }
 
 /// The contacts `list` switched stick → sliding as the low-rank correction A₀ − W Wᵀ (W their
-/// stick-spring columns, E = −I) of the factorization `a0` of the unswitched matrix: seconds of
-/// the first solve (columns with the right-hand side's forward half, LU, a backward half) and
-/// its stages (columns, capacitance, solve) from the run of median total among `repeats` (at
-/// least [`LOW_RANK_REPEATS`], each from no columns), the median seconds of the next solve on the same columns with the load changed
-/// within them (LU, one solve), and the first solves' largest backward error on the switched
-/// matrix `a`.
+/// stick-spring columns, E = −I) of the factorization `a0` of the unswitched matrix `base`.
+/// Runs `repeats` times (at least [`LOW_RANK_REPEATS`]), each from no columns: a
+/// refactorization of `base` plus a solve, then the first solve (the columns with the
+/// right-hand side's forward half, the capacitance, the rest of the solve), then the next
+/// solve on the same columns with the load changed within them (capacitance, one backward
+/// half). Returns the median refactorization, the first solve and its stages from the run of
+/// median total, the median next solve, and the first solves' largest backward error on the
+/// switched matrix `a`.
 fn low_rank_switch(
     sys: &PeriodicSystem,
     a0: &mut dyn fibercell_solver::LinearSolver,
+    base: CscRef<'_>,
     a: CscRef<'_>,
     rhs: &[f64],
     list: &[usize],
@@ -390,7 +407,10 @@ fn low_rank_switch(
     let mut firsts: Vec<(f64, [f64; 3])> = Vec::new();
     let mut nexts = Vec::new();
     let mut error = 0.0f64;
+    let mut refactorizations = Vec::new();
     for _ in 0..repeats.max(LOW_RANK_REPEATS) {
+        // It ends with a solve, as the next solves of the runs before do.
+        refactorizations.push(refactorize_once(a0, base, rhs)?);
         let mut low_rank = LowRankCorrection::new(a.ncols(), list.len());
         let t = Instant::now();
         // The columns' forward solves take the right-hand side's forward half along.
@@ -414,6 +434,7 @@ fn low_rank_switch(
     firsts.sort_by(|p, q| p.0.total_cmp(&q.0));
     let (first, stages) = firsts[firsts.len() / 2];
     Ok(LowRankSwitch {
+        refactorization: median(refactorizations),
         first,
         next: median(nexts),
         stages,
@@ -423,6 +444,8 @@ fn low_rank_switch(
 
 /// What [`low_rank_switch`] measured (s) and the first solve's backward error.
 struct LowRankSwitch {
+    /// The median refactorization plus solve, one timed right before each first solve.
+    refactorization: f64,
     first: f64,
     next: f64,
     stages: [f64; 3],
@@ -430,8 +453,9 @@ struct LowRankSwitch {
 }
 
 /// Solves after switching k contacts, for k at the given fractions of the contacts, against
-/// a [`refactorization`] (`repeats` of them); CG stops once it has spent about two
-/// refactorizations.
+/// refactorizations plus solve on the same solver timed alongside the low-rank first solves
+/// (see [`low_rank_switch`]); CG stops once it has spent about two refactorizations (a
+/// [`refactorization`] measured first).
 fn bench_reuse(
     sys: &PeriodicSystem,
     model: &Model,
@@ -473,7 +497,9 @@ fn bench_reuse(
         let r = pcg_with_factor(factor.as_mut(), a, rhs, 1e-13, max_iterations)?;
         let seconds = t.elapsed().as_secs_f64();
         let list: Vec<usize> = (0..n_contacts).filter(|&i| switched(i)).collect();
-        let low_rank = low_rank_switch(sys, factor.as_mut(), a, rhs, &list, repeats)?;
+        let low_rank = low_rank_switch(sys, factor.as_mut(), a0, a, rhs, &list, repeats)?;
+        // The row's faer ratios divide by the refactorizations paired with its first solves.
+        let refactor = low_rank.refactorization;
         let mut measured = None;
         let cholmod_refactor = updown.as_ref().map_or(f64::NAN, |u| u.1);
         if let Some((solver, _)) = updown.as_mut() {
