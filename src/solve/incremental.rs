@@ -17,6 +17,7 @@
 //! Otherwise systems with a Coulomb-sliding contact are nonsymmetric and go to LU, all others
 //! to the chosen symmetric backend.
 
+use super::kept_contact_loads::KeptContactLoads;
 use super::low_rank::{Capacitance, ContactChange, LowRankCorrection, Reference, SparseColumn};
 use super::static_solve::{backward_tolerance, check_backward_error};
 use super::{check_supported_with, make_solver, IncrementTimings, SolveOptions, SolverKind};
@@ -994,6 +995,10 @@ pub(crate) fn run_incremental(
                 .collect()
         })
         .collect();
+    // The loads of the contacts without prescribed DOFs in their base states (open as open, the
+    // others stuck) with the slips they were summed at: kept across increments and updated at
+    // the contacts whose base state or slip changed (few per increment), instead of summed anew.
+    let mut contact_base_load: Option<KeptContactLoads> = None;
     let block_state = |states: &[ContactState],
                        directions: &[Vector2<f64>],
                        perpendicular: &[(f64, Vector2<f64>)],
@@ -1178,20 +1183,23 @@ pub(crate) fn run_incremental(
                 }
             };
             // Color by color in parallel (sums independent of the number of threads).
-            let by_colors = |state: &(dyn Fn(usize) -> ContactState + Sync),
+            // (`None`: the contact is left out.)
+            let by_colors = |state: &(dyn Fn(usize) -> Option<ContactState> + Sync),
                              rhs: &mut [f64],
                              values: Option<&mut [f64]>| {
                 let shared_rhs = SharedMut::new(rhs);
                 let shared_values = values.map(SharedMut::new);
                 for color in &contact_colors {
                     color.par_iter().with_min_len(16).for_each(|&i| {
-                        contact_into(i, state(i), 1.0, &shared_rhs, shared_values.as_ref())
+                        if let Some(state) = state(i) {
+                            contact_into(i, state, 1.0, &shared_rhs, shared_values.as_ref())
+                        }
                     });
                 }
             };
             if write_values {
                 // The contact blocks and loads for the current states.
-                by_colors(&|i| states[i], &mut rhs, Some(&mut values));
+                by_colors(&|i| Some(states[i]), &mut rhs, Some(&mut values));
             } else {
                 // Only the load: once per increment every contact stuck, or open if it is open
                 // now (α and the slips are fixed within it), then the contacts in another state
@@ -1204,8 +1212,31 @@ pub(crate) fn run_incremental(
                             _ => ContactState::Stick,
                         })
                         .collect();
-                    let mut base = rhs.clone();
-                    by_colors(&|i| states[i], &mut base, None);
+                    // The contacts without prescribed DOFs: their kept sum, updated where the
+                    // base state or the slip changed (an open contact's load is zero, a stuck
+                    // one's its stick load).
+                    let free = |i: usize| prescribed[i].is_empty();
+                    let kept = contact_base_load.get_or_insert_with(|| {
+                        let mut sum = vec![0.0; rhs.len()];
+                        by_colors(&|i| free(i).then_some(states[i]), &mut sum, None);
+                        KeptContactLoads::new(&states, &slips, sum)
+                    });
+                    kept.update(&states, &slips, free, |i, state, slip, sign, out| {
+                        if state != ContactState::Stick {
+                            return;
+                        }
+                        let pair = &pairs[i];
+                        let f = pair.stick_load(slip);
+                        for (r, fr) in f.iter().enumerate().take(pair.size()) {
+                            if let Some(ir) = disc.reduced(6 * pair.jump.nodes[r / 6] + r % 6) {
+                                out[ir] += sign * fr;
+                            }
+                        }
+                    });
+                    let mut base: Vec<f64> =
+                        rhs.iter().zip(kept.sum()).map(|(r, k)| r + k).collect();
+                    // The contacts on prescribed DOFs, whose loads follow α.
+                    by_colors(&|i| (!free(i)).then_some(states[i]), &mut base, None);
                     (states, base)
                 });
                 rhs.copy_from_slice(base);

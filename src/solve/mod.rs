@@ -5,6 +5,7 @@ mod connectivity;
 mod gram;
 mod increment_timings;
 mod incremental;
+mod kept_contact_loads;
 mod low_rank;
 mod reduced;
 mod static_solve;
