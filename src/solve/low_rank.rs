@@ -14,12 +14,17 @@
 
 use super::gram::new_gram_columns;
 use crate::contact::BlockCoefficients;
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::{PartialPivLu, Solve};
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use fibercell_solver::{ForwardColumns, LinearSolver, SolverError};
 use nalgebra::Vector6;
 use rayon::prelude::*;
+use std::cell::RefCell;
 use std::collections::HashMap;
 
 /// The order in which a contact's jump rows become columns of U: the two tangents first (all a
@@ -146,7 +151,9 @@ enum CapacitanceFactor {
     /// definite I − Cᵀ S C by Cholesky, half the flops of an LU. C_c row-major per block.
     Cholesky {
         c: Vec<Vec<f64>>,
-        llt: faer::linalg::solvers::Llt<f64>,
+        /// The factor L, column-major, order [`Capacitance::order`] (its lower triangle; the
+        /// strict upper one holds the matrix's entries, unused).
+        l: Vec<f64>,
     },
     /// Otherwise I + E S by LU with partial pivoting.
     Lu(PartialPivLu<f64>),
@@ -248,7 +255,7 @@ impl LowRankCorrection {
         let first = self.add_columns(changes, column);
         let mut b = b0(self);
         if self.solve_columns(a0, first, Some(&mut b))? {
-            Ok(Reference::Forward(b))
+            Ok(Reference::forward(b))
         } else {
             self.reference(a0, b)
         }
@@ -435,11 +442,11 @@ impl LowRankCorrection {
             .map(|(cols, e)| negative_square_root(e, cols.len()))
             .collect();
         if let Some(c) = roots {
-            if let Some(llt) = self.symmetric_capacitance(&blocks, &active, &c) {
+            if let Some(l) = self.symmetric_capacitance(&blocks, &active, &c) {
                 return Capacitance {
                     blocks,
                     active,
-                    factor: CapacitanceFactor::Cholesky { c, llt },
+                    factor: CapacitanceFactor::Cholesky { c, l },
                 };
             }
         }
@@ -468,14 +475,15 @@ impl LowRankCorrection {
         }
     }
 
-    /// The Cholesky factor of I − Cᵀ S C (C block diagonal, `c` per block of `blocks`), or
-    /// `None` when it is not numerically positive definite.
+    /// The Cholesky factor of I − Cᵀ S C (C block diagonal, `c` per block of `blocks`), factorized
+    /// in place where the matrix is built (its lower triangle, column-major), or `None` when it is
+    /// not numerically positive definite.
     fn symmetric_capacitance(
         &self,
         blocks: &[(Vec<usize>, Vec<f64>)],
         active: &[usize],
         c: &[Vec<f64>],
-    ) -> Option<faer::linalg::solvers::Llt<f64>> {
+    ) -> Option<Vec<f64>> {
         let r = active.len();
         // Column j of the matrix belongs to block b, local column a.
         let owner: Vec<(usize, usize)> = blocks
@@ -511,9 +519,22 @@ impl LowRankCorrection {
                 }
                 out[j] += 1.0;
             });
-        MatRef::from_column_major_slice(&data, r, r)
-            .llt(faer::Side::Lower)
-            .ok()
+        use faer::linalg::cholesky::llt::factor;
+        let par = Par::rayon(0);
+        let mut scratch = MemBuffer::new(factor::cholesky_in_place_scratch::<f64>(
+            r,
+            par,
+            Default::default(),
+        ));
+        factor::cholesky_in_place(
+            MatMut::from_column_major_slice_mut(&mut data, r, r),
+            Default::default(),
+            par,
+            MemStack::new(&mut scratch),
+            Default::default(),
+        )
+        .ok()?;
+        Some(data)
     }
 
     /// The load changes Δχ of `changes` on the columns of `cap` (same order).
@@ -561,7 +582,7 @@ impl LowRankCorrection {
     ) -> Result<Vec<f64>, SolverError> {
         let v = self.coefficients(cap, &reference, load)?;
         match reference {
-            Reference::Forward(f) => self.backward_from(a0, f, &v),
+            Reference::Forward(f, _) => self.backward_from(a0, f, &v),
             full => self.finish(a0, &full, &v),
         }
     }
@@ -575,7 +596,7 @@ impl LowRankCorrection {
     ) -> Result<Reference, SolverError> {
         if matches!(self.mode, ColumnMode::Forward(_)) {
             a0.solve_lower_in_place(&mut b0)?;
-            Ok(Reference::Forward(b0))
+            Ok(Reference::forward(b0))
         } else {
             a0.solve_in_place(&mut b0, 1)?;
             Ok(Reference::Full(b0))
@@ -611,9 +632,10 @@ impl LowRankCorrection {
                 .iter()
                 .map(|&c| dot(&self.columns[c], x0))
                 .collect(),
-            Reference::Forward(f0) => {
-                let all = self.forward_transpose(f0);
-                cap.active.iter().map(|&c| all[c]).collect()
+            Reference::Forward(f0, projection) => {
+                let mut projection = projection.borrow_mut();
+                self.extend_projection(f0, &mut projection);
+                cap.active.iter().map(|&c| projection[c]).collect()
             }
         };
         let y: Vec<f64> = cap
@@ -660,7 +682,7 @@ impl LowRankCorrection {
         v: &[f64],
     ) -> Result<Vec<f64>, SolverError> {
         match (reference, &self.mode) {
-            (Reference::Forward(f0), _) => self.backward_from(a0, f0.clone(), v),
+            (Reference::Forward(f0, _), _) => self.backward_from(a0, f0.clone(), v),
             (Reference::Full(x0), ColumnMode::Forward(_)) => {
                 let mut w = vec![0.0; self.n];
                 self.forward_spread(v, &mut w);
@@ -680,29 +702,41 @@ impl LowRankCorrection {
         }
     }
 
-    /// Wᵀ f for every column (f in the factor's row order); zeros without forward solves.
-    fn forward_transpose(&self, f: &[f64]) -> Vec<f64> {
-        let mut out = vec![0.0; self.columns.len()];
+    /// Extends `projection`, Wᵀ f for the columns before its length (f in the factor's row
+    /// order), to every column: the products of each block's columns added since, which come
+    /// after its older ones. Zeros without forward solves.
+    fn extend_projection(&self, f: &[f64], projection: &mut Vec<f64>) {
+        if projection.len() > self.columns.len() {
+            // Not from these columns (they were reset): anew.
+            projection.clear();
+        }
+        let known = projection.len();
+        projection.resize(self.columns.len(), 0.0);
         if let ColumnMode::Forward(store) = &self.mode {
             // One buffer for every block's products.
             let mut products = Vec::new();
             for blk in store.values() {
+                let new = blk.columns.partition_point(|&c| c < known);
+                debug_assert!(blk.columns[new..].iter().all(|&c| c >= known));
+                if new == blk.columns.len() {
+                    continue;
+                }
                 let rows = &f[blk.first_row..blk.first_row + blk.rows];
-                products.resize(blk.columns.len(), 0.0);
+                let w = blk.matrix().subcols(new, blk.columns.len() - new);
+                products.resize(w.ncols(), 0.0);
                 matmul(
-                    MatMut::from_column_major_slice_mut(&mut products, blk.columns.len(), 1),
+                    MatMut::from_column_major_slice_mut(&mut products, w.ncols(), 1),
                     Accum::Replace,
-                    blk.matrix().transpose(),
+                    w.transpose(),
                     MatRef::from_column_major_slice(rows, blk.rows, 1),
                     1.0,
                     blk.par(),
                 );
-                for (&c, p) in blk.columns.iter().zip(&products) {
-                    out[c] += p;
+                for (&c, p) in blk.columns[new..].iter().zip(&products) {
+                    projection[c] += p;
                 }
             }
         }
-        out
     }
 
     /// out += W v (factor row order), `v` a coefficient per column; nothing without forward
@@ -739,8 +773,16 @@ impl LowRankCorrection {
 pub(crate) enum Reference {
     /// The solution.
     Full(Vec<f64>),
-    /// Its forward half L⁻¹ P Ŝ b₀ (factor row order).
-    Forward(Vec<f64>),
+    /// Its forward half f = L⁻¹ P Ŝ b₀ (factor row order), and Wᵀ f for the columns so far:
+    /// kept across the solves from it and extended to the columns added in between.
+    Forward(Vec<f64>, RefCell<Vec<f64>>),
+}
+
+impl Reference {
+    /// The reference of the forward half `f`.
+    fn forward(f: Vec<f64>) -> Self {
+        Reference::Forward(f, RefCell::new(Vec::new()))
+    }
 }
 
 impl Capacitance {
@@ -759,7 +801,7 @@ impl Capacitance {
                 }
                 lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut z, r, 1));
             }
-            CapacitanceFactor::Cholesky { c, llt } => {
+            CapacitanceFactor::Cholesky { c, l } => {
                 // E = −C Cᵀ: z = −C t with (I − Cᵀ S C) t = Cᵀ y.
                 let mut t = Vec::with_capacity(r);
                 let mut offset = 0;
@@ -769,7 +811,16 @@ impl Capacitance {
                     t.extend((0..k).map(|a| (0..k).map(|i| c[b][i * k + a] * u[i]).sum::<f64>()));
                     offset += k;
                 }
-                llt.solve_in_place(MatMut::from_column_major_slice_mut(&mut t, r, 1));
+                let l = MatRef::from_column_major_slice(l, r, r);
+                let mut t_mat = MatMut::from_column_major_slice_mut(&mut t, r, 1);
+                // Each half reads L once: both threads from a large one on.
+                let par = if r * r >= PARALLEL_PRODUCT {
+                    Par::rayon(0)
+                } else {
+                    Par::Seq
+                };
+                solve_lower_triangular_in_place(l, t_mat.as_mut(), par);
+                solve_upper_triangular_in_place(l.transpose(), t_mat, par);
                 let mut offset = 0;
                 for (b, (cols, _)) in self.blocks.iter().enumerate() {
                     let k = cols.len();
@@ -867,6 +918,16 @@ mod tests {
         low_rank
             .extend(solver.as_mut(), &first, column)
             .expect("extend");
+        let b: Vec<f64> = (0..n).map(|i| ((i * 31) % 11) as f64 - 5.0).collect();
+        // A reference taken on the first columns and solved from once (its projection kept
+        // for them), used again below once the other columns are there.
+        let early = low_rank
+            .reference(solver.as_mut(), b.clone())
+            .expect("solve");
+        let cap = low_rank.capacitance(&first);
+        low_rank
+            .solve_from(solver.as_mut(), &cap, &early, &low_rank.active_load(&first))
+            .expect("solve");
         let changes = vec![ch(0, 2), ch(1, 6), ch(2, 3)];
         assert_eq!(low_rank.size_of(&changes), (11, 6));
         low_rank
@@ -923,7 +984,6 @@ mod tests {
                 assert!((low_rank.s[(r, s)] - expected).abs() <= 1e-12 * expected.abs().max(1.0));
             }
         }
-        let b: Vec<f64> = (0..n).map(|i| ((i * 31) % 11) as f64 - 5.0).collect();
         let cap = low_rank.capacitance(&changes);
         assert!(matches!(cap.factor, CapacitanceFactor::Lu(_)));
         let x = low_rank.solve(solver.as_mut(), &cap, &b).expect("solve");
@@ -950,7 +1010,7 @@ mod tests {
         let kept = low_rank
             .reference(solver.as_mut(), b.clone())
             .expect("solve");
-        assert_eq!(matches!(kept, Reference::Forward(_)), forward);
+        assert_eq!(matches!(kept, Reference::Forward(..)), forward);
         // The same columns with b₀'s reference taken along (fused with the forward solves
         // where S comes from them): the same S and reference, to 1e-12.
         let mut along = LowRankCorrection::new(n, 4);
@@ -966,14 +1026,14 @@ mod tests {
         let scale = low_rank.s.norm_max();
         assert!((&along.s - &low_rank.s).norm_max() <= 1e-12 * scale);
         match (&taken, &kept) {
-            (Reference::Forward(p), Reference::Forward(q))
+            (Reference::Forward(p, _), Reference::Forward(q, _))
             | (Reference::Full(p), Reference::Full(q)) => {
                 let big = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 assert!(p.iter().zip(q).all(|(x, y)| (x - y).abs() <= 1e-12 * big));
             }
             _ => panic!("{kind:?}: references of different kinds"),
         }
-        for reference in [Reference::Full(x0), kept] {
+        for reference in [Reference::Full(x0), kept, early] {
             let x1 = low_rank
                 .solve_from(solver.as_mut(), &cap, &reference, &load)
                 .expect("solve");
