@@ -556,15 +556,21 @@ fn add_block_change(pair: &ContactPair, slots: &[u32], e: &BlockCoefficients, va
     }
 }
 
+/// The rows of `pair`'s block on free DOFs: (row in the block, free DOF).
+fn free_rows<'a>(
+    pair: &'a ContactPair,
+    disc: &'a Discretization,
+) -> impl Iterator<Item = (usize, usize)> + 'a {
+    (0..pair.size()).filter_map(move |r| {
+        disc.reduced(6 * pair.jump.nodes[r / 6] + r % 6)
+            .map(|i| (r, i))
+    })
+}
+
 /// The column of U for basis row `k` of `pair`'s jump basis in the free DOFs.
 fn low_rank_column(pair: &ContactPair, disc: &Discretization, k: usize) -> SparseColumn {
     let g = pair.jump_basis()[k];
-    let mut col: SparseColumn = (0..pair.size())
-        .filter_map(|r| {
-            let gdof = 6 * pair.jump.nodes[r / 6] + r % 6;
-            disc.reduced(gdof).map(|i| (i, g[r]))
-        })
-        .collect();
+    let mut col: SparseColumn = free_rows(pair, disc).map(|(r, i)| (i, g[r])).collect();
     col.sort_unstable_by_key(|e| e.0);
     col.dedup_by(|b, a| {
         if a.0 == b.0 {
@@ -1225,12 +1231,9 @@ pub(crate) fn run_incremental(
                         if state != ContactState::Stick {
                             return;
                         }
-                        let pair = &pairs[i];
-                        let f = pair.stick_load(slip);
-                        for (r, fr) in f.iter().enumerate().take(pair.size()) {
-                            if let Some(ir) = disc.reduced(6 * pair.jump.nodes[r / 6] + r % 6) {
-                                out[ir] += sign * fr;
-                            }
+                        let f = pairs[i].stick_load(slip);
+                        for (r, ir) in free_rows(&pairs[i], disc) {
+                            out[ir] += sign * f[r];
                         }
                     });
                     let mut base: Vec<f64> =
@@ -1263,12 +1266,9 @@ pub(crate) fn run_incremental(
                     for (ga, pa) in pair.jump_basis().iter().zip(phi.iter()) {
                         f += ga * *pa;
                     }
-                    for (r, fr) in f.iter().enumerate().take(pair.size()) {
-                        let gdof = 6 * pair.jump.nodes[r / 6] + r % 6;
-                        if let Some(ir) = disc.reduced(gdof) {
-                            // SAFETY: one contact at a time.
-                            unsafe { *shared_rhs.get(ir) += fr };
-                        }
+                    for (r, ir) in free_rows(pair, disc) {
+                        // SAFETY: one contact at a time.
+                        unsafe { *shared_rhs.get(ir) += f[r] };
                     }
                 }
             }

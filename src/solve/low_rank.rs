@@ -15,6 +15,7 @@
 use super::gram::new_gram_columns;
 use crate::contact::BlockCoefficients;
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::linalg::triangular_solve::{
@@ -124,14 +125,20 @@ impl StoredBlock {
         MatRef::from_column_major_slice(&self.values, self.rows, self.columns.len())
     }
 
-    /// The threads of a product with one vector: all of them for a block of at least
-    /// [`PARALLEL_PRODUCT`] values (read once, bandwidth-bound on one core).
+    /// The threads of a product with one vector (see [`one_vector_par`]).
     fn par(&self) -> Par {
-        if self.values.len() >= PARALLEL_PRODUCT {
-            Par::rayon(0)
-        } else {
-            Par::Seq
-        }
+        one_vector_par(self.values.len())
+    }
+}
+
+/// The threads of a product or triangular solve with one vector over a matrix of `values`
+/// entries: all of them from [`PARALLEL_PRODUCT`] on (the matrix is read once,
+/// bandwidth-bound on one core), else one.
+fn one_vector_par(values: usize) -> Par {
+    if values >= PARALLEL_PRODUCT {
+        Par::rayon(0)
+    } else {
+        Par::Seq
     }
 }
 
@@ -519,14 +526,10 @@ impl LowRankCorrection {
                 }
                 out[j] += 1.0;
             });
-        use faer::linalg::cholesky::llt::factor;
         let par = Par::rayon(0);
-        let mut scratch = MemBuffer::new(factor::cholesky_in_place_scratch::<f64>(
-            r,
-            par,
-            Default::default(),
-        ));
-        factor::cholesky_in_place(
+        let mut scratch =
+            MemBuffer::new(cholesky_in_place_scratch::<f64>(r, par, Default::default()));
+        cholesky_in_place(
             MatMut::from_column_major_slice_mut(&mut data, r, r),
             Default::default(),
             par,
@@ -813,12 +816,7 @@ impl Capacitance {
                 }
                 let l = MatRef::from_column_major_slice(l, r, r);
                 let mut t_mat = MatMut::from_column_major_slice_mut(&mut t, r, 1);
-                // Each half reads L once: both threads from a large one on.
-                let par = if r * r >= PARALLEL_PRODUCT {
-                    Par::rayon(0)
-                } else {
-                    Par::Seq
-                };
+                let par = one_vector_par(r * r);
                 solve_lower_triangular_in_place(l, t_mat.as_mut(), par);
                 solve_upper_triangular_in_place(l.transpose(), t_mat, par);
                 let mut offset = 0;
