@@ -414,7 +414,8 @@ fn low_rank_switch(
         let mut low_rank = LowRankCorrection::new(a.ncols(), list.len());
         let t = Instant::now();
         // The columns' forward solves take the right-hand side's forward half along.
-        let reference = low_rank.extend_with_reference(a0, &changes, column, |_| rhs.to_vec())?;
+        let reference =
+            low_rank.extend_with_reference(a0, &changes, column, |_| rhs.to_vec(), |_, _| None)?;
         let columns = t.elapsed().as_secs_f64();
         let cap = low_rank.capacitance(&changes);
         let capacitance = t.elapsed().as_secs_f64() - columns;

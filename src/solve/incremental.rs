@@ -17,6 +17,7 @@
 //! Otherwise systems with a Coulomb-sliding contact are nonsymmetric and go to LU, all others
 //! to the chosen symmetric backend.
 
+use super::affine_reference::AffineReferences;
 use super::kept_contact_loads::KeptContactLoads;
 use super::low_rank::{Capacitance, ContactChange, LowRankCorrection, Reference, SparseColumn};
 use super::static_solve::{backward_tolerance, check_backward_error};
@@ -539,6 +540,9 @@ struct ReferenceBlock {
     stiffness: BlockCoefficients,
     state: BlockState,
     anchor: Vector2<f64>,
+    /// The slip its load was computed at: the reference load b₀ keeps it, so that b₀ changes
+    /// with α only (see [`AffineReferences`]); a contact whose slip moved since is a change.
+    slip: Vector2<f64>,
 }
 
 /// Adds G ΔD Gᵀ, the change `e` of `pair`'s block coefficients, to its slots in `values`.
@@ -985,9 +989,12 @@ pub(crate) fn run_incremental(
     // The block coefficients of every contact in the last symmetric factorization (the
     // reference A₀ of the low-rank solves), and the correction accumulated on it.
     let mut reference: Option<Vec<ReferenceBlock>> = None;
-    // A₀⁻¹ b₀ for this increment, b₀ the load with every contact as in the reference.
+    // A₀⁻¹ b₀ for this increment, b₀ the load with every contact as in the reference (its
+    // state, slip direction and slip there).
     let mut reference_solution: Option<Reference>;
     let mut low_rank = LowRankCorrection::new(n_free, pairs.len());
+    // The references of earlier increments' b₀ on it, when b₀ is affine in α.
+    let mut affine = AffineReferences::default();
     let mut reference_values = vec![0.0; pattern.nnz()];
     // When `values` is `reference_values` plus the blocks of these contacts only: restoring
     // their slots is enough to start the next iteration from the reference.
@@ -1070,7 +1077,7 @@ pub(crate) fn run_incremental(
                             &slips[i],
                             friction,
                         ) - pairs[i]
-                            .load_coefficients(&r.state, &r.anchor, &slips[i], friction)
+                            .load_coefficients(&r.state, &r.anchor, &r.slip, friction)
                             - stiffness * prescribed_jump[i];
                         let change = ContactChange {
                             contact: i,
@@ -1312,15 +1319,35 @@ pub(crate) fn run_incremental(
                                 .map_err(locate)?;
                             x0
                         }
-                        // b₀ = b − U Δχ, the load with every contact as in the reference; its
+                        // b₀ = b − U Δχ, the load with every contact as in the reference: from
+                        // the references of two earlier increments when affine in α, else its
                         // forward half along with the new columns' forward solves.
-                        None => low_rank
-                            .extend_with_reference(a0.as_mut(), changes, column, |low_rank| {
-                                let load = low_rank.active_load(changes);
-                                let shift = low_rank.spread(changes, &load);
-                                rhs.iter().zip(&shift).map(|(b, s)| b - s).collect()
-                            })
-                            .map_err(locate)?,
+                        None => {
+                            let mut solved_b0 = None;
+                            let x0 = low_rank
+                                .extend_with_reference(
+                                    a0.as_mut(),
+                                    changes,
+                                    column,
+                                    |low_rank| {
+                                        let load = low_rank.active_load(changes);
+                                        let shift = low_rank.spread(changes, &load);
+                                        rhs.iter().zip(&shift).map(|(b, s)| b - s).collect()
+                                    },
+                                    |low_rank, b0| {
+                                        let known = affine.predict(alpha, b0, low_rank);
+                                        if known.is_none() {
+                                            solved_b0 = Some(b0.to_vec());
+                                        }
+                                        known
+                                    },
+                                )
+                                .map_err(locate)?;
+                            if let Some(b0) = solved_b0 {
+                                affine.record(alpha, b0, &x0);
+                            }
+                            x0
+                        }
                     };
                     let started = std::time::Instant::now();
                     let cap = low_rank.capacitance(changes);
@@ -1414,6 +1441,7 @@ pub(crate) fn run_incremental(
                                         ),
                                         state,
                                         anchor: perpendicular[i].1,
+                                        slip: slips[i],
                                     }
                                 })
                                 .collect(),
@@ -1422,6 +1450,7 @@ pub(crate) fn run_incremental(
                         reference_values.copy_from_slice(&values);
                         changed_since_reference = Some(Vec::new());
                         low_rank.reset();
+                        affine.clear();
                         // The initial states are all-stick unless frictionless (sliding).
                         if let Some(hook) = on_all_stick.take() {
                             if friction != Friction::None

@@ -252,15 +252,23 @@ impl LowRankCorrection {
     /// (called once the new columns are there, e.g. to take U Δχ off the load): with S from
     /// forward solves, b₀'s forward half goes through the factor along with the first new
     /// columns, each block of L read once for both.
+    /// `known(b₀)`, when it gives the reference without a solve (see
+    /// [`super::affine_reference::AffineReferences`]), is taken instead, and the new columns
+    /// are solved for alone.
     pub(crate) fn extend_with_reference(
         &mut self,
         a0: &mut dyn LinearSolver,
         changes: &[ContactChange],
         column: impl Fn(usize, usize) -> SparseColumn + Sync,
         b0: impl FnOnce(&Self) -> Vec<f64>,
+        known: impl FnOnce(&Self, &[f64]) -> Option<Reference>,
     ) -> Result<Reference, SolverError> {
         let first = self.add_columns(changes, column);
         let mut b = b0(self);
+        if let Some(reference) = known(self, &b) {
+            self.solve_columns(a0, first, None)?;
+            return Ok(reference);
+        }
         if self.solve_columns(a0, first, Some(&mut b))? {
             Ok(Reference::forward(b))
         } else {
@@ -705,6 +713,14 @@ impl LowRankCorrection {
         }
     }
 
+    /// Extends a forward reference's Wᵀ f to the columns so far (see
+    /// [`Reference::Forward`]); nothing for a full one.
+    pub(crate) fn project(&self, reference: &Reference) {
+        if let Reference::Forward(f, projection) = reference {
+            self.extend_projection(f, &mut projection.borrow_mut());
+        }
+    }
+
     /// Extends `projection`, Wᵀ f for the columns before its length (f in the factor's row
     /// order), to every column: the products of each block's columns added since, which come
     /// after its older ones. Zeros without forward solves.
@@ -785,6 +801,26 @@ impl Reference {
     /// The reference of the forward half `f`.
     fn forward(f: Vec<f64>) -> Self {
         Reference::Forward(f, RefCell::new(Vec::new()))
+    }
+
+    /// (1 − t) `a` + t `b`: the reference of (1 − t) b₀ₐ + t b₀ᵦ, as A₀⁻¹ and its halves are
+    /// linear (Wᵀ f too, for the columns both have); `None` when they are not of one kind.
+    pub(crate) fn combine(a: &Reference, b: &Reference, t: f64) -> Option<Reference> {
+        let mix = |u: &[f64], v: &[f64]| -> Vec<f64> {
+            u.iter().zip(v).map(|(u, v)| u + t * (v - u)).collect()
+        };
+        match (a, b) {
+            (Reference::Full(x), Reference::Full(y)) => Some(Reference::Full(mix(x, y))),
+            (Reference::Forward(f, p), Reference::Forward(g, q)) => {
+                let (p, q) = (p.borrow(), q.borrow());
+                let known = p.len().min(q.len());
+                Some(Reference::Forward(
+                    mix(f, g),
+                    RefCell::new(mix(&p[..known], &q[..known])),
+                ))
+            }
+            _ => None,
+        }
     }
 }
 
@@ -1016,10 +1052,16 @@ mod tests {
             .extend(solver.as_mut(), &first, column)
             .expect("extend");
         let taken = along
-            .extend_with_reference(solver.as_mut(), &changes, column, |lr| {
-                assert_eq!(lr.len(), 11, "the new columns are there");
-                b.clone()
-            })
+            .extend_with_reference(
+                solver.as_mut(),
+                &changes,
+                column,
+                |lr| {
+                    assert_eq!(lr.len(), 11, "the new columns are there");
+                    b.clone()
+                },
+                |_, _| None,
+            )
             .expect("extend");
         let scale = low_rank.s.norm_max();
         assert!((&along.s - &low_rank.s).norm_max() <= 1e-12 * scale);

@@ -1,5 +1,6 @@
 //! Choosing a backend and solving the static problem K u = F.
 
+mod affine_reference;
 mod backend;
 mod connectivity;
 mod gram;
