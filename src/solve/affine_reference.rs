@@ -89,26 +89,9 @@ impl AffineReferences {
 mod tests {
     use super::*;
     use crate::contact::BlockCoefficients;
-    use crate::solve::{make_solver, ContactChange, SolverKind};
-    use fibercell_solver::{CscMatrix, LinearSolver, Ordering};
+    use crate::solve::low_rank::tests::path_graph_factor;
+    use crate::solve::{ContactChange, SolverKind};
     use nalgebra::Vector6;
-
-    /// A path-graph Laplacian plus a diagonal, factorized by `kind`.
-    fn factorized(n: usize, kind: SolverKind) -> Box<dyn LinearSolver> {
-        let mut triplets = Vec::new();
-        for i in 0..n {
-            triplets.push((i, i, 3.0 + (i % 5) as f64 * 0.2));
-            if i + 1 < n {
-                triplets.push((i, i + 1, -1.0));
-                triplets.push((i + 1, i, -1.0));
-            }
-        }
-        let a = CscMatrix::from_triplets(n, n, &triplets).expect("matrix");
-        let mut solver = make_solver(kind, &Ordering::Auto, Vec::new()).expect("solver");
-        solver.analyze(a.as_ref()).expect("analyze");
-        solver.factorize(a.as_ref()).expect("factorize");
-        solver
-    }
 
     /// Two contacts' changes of two tangential columns each (springs removed, as stick → slip).
     fn changes() -> Vec<ContactChange> {
@@ -128,16 +111,16 @@ mod tests {
             .collect()
     }
 
-    /// b₀(α) = c + α d on a low-rank correction with columns added between the points and the
-    /// prediction: the solve from the predicted reference equals the solve from one computed
-    /// for b₀(α) (1e-12), at t = 4 from the points; beyond MAX_EXTRAPOLATION, with one point,
-    /// or with b₀ off the line by 1e-9 there is none. With forward references (faer Cholesky)
-    /// and full ones (faer LU).
+    /// b₀(α) = c + α d on a low-rank correction of a path-graph Laplacian plus a diagonal,
+    /// with columns added between the points and the prediction: the solve from the predicted
+    /// reference equals the solve from one computed for b₀(α) (1e-12), at t = 4 from the
+    /// points; beyond MAX_EXTRAPOLATION, with one point, or with b₀ off the line by 1e-9 there
+    /// is none. With forward references (faer Cholesky) and full ones (faer LU).
     #[test]
     fn a_load_affine_in_alpha_is_solved_from_two_points() {
         for kind in [SolverKind::FaerCholesky, SolverKind::FaerLu] {
             let n = 40;
-            let mut a0 = factorized(n, kind);
+            let (_, mut a0) = path_graph_factor(n, kind);
             let column = |c: usize, k: usize| {
                 vec![
                     ((5 * c + 3 * k) % n, 1.0),

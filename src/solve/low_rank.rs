@@ -252,6 +252,7 @@ impl LowRankCorrection {
     /// (called once the new columns are there, e.g. to take U Δχ off the load): with S from
     /// forward solves, b₀'s forward half goes through the factor along with the first new
     /// columns, each block of L read once for both.
+    ///
     /// `known(b₀)`, when it gives the reference without a solve (see
     /// [`super::affine_reference::AffineReferences`]), is taken instead, and the new columns
     /// are solved for alone.
@@ -643,9 +644,9 @@ impl LowRankCorrection {
                 .iter()
                 .map(|&c| dot(&self.columns[c], x0))
                 .collect(),
-            Reference::Forward(f0, projection) => {
-                let mut projection = projection.borrow_mut();
-                self.extend_projection(f0, &mut projection);
+            Reference::Forward(_, projection) => {
+                self.project(reference);
+                let projection = projection.borrow();
                 cap.active.iter().map(|&c| projection[c]).collect()
             }
         };
@@ -713,18 +714,15 @@ impl LowRankCorrection {
         }
     }
 
-    /// Extends a forward reference's Wᵀ f to the columns so far (see
-    /// [`Reference::Forward`]); nothing for a full one.
+    /// Extends a forward reference's Wᵀ f (f in the factor's row order), kept for the columns
+    /// before its length, to every column: the products of each block's columns added since,
+    /// which come after its older ones. Zeros without forward solves; nothing for a full
+    /// reference.
     pub(crate) fn project(&self, reference: &Reference) {
-        if let Reference::Forward(f, projection) = reference {
-            self.extend_projection(f, &mut projection.borrow_mut());
-        }
-    }
-
-    /// Extends `projection`, Wᵀ f for the columns before its length (f in the factor's row
-    /// order), to every column: the products of each block's columns added since, which come
-    /// after its older ones. Zeros without forward solves.
-    fn extend_projection(&self, f: &[f64], projection: &mut Vec<f64>) {
+        let Reference::Forward(f, projection) = reference else {
+            return;
+        };
+        let mut projection = projection.borrow_mut();
         if projection.len() > self.columns.len() {
             // Not from these columns (they were reset): anew.
             projection.clear();
@@ -875,7 +873,7 @@ impl Capacitance {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::solve::{make_solver, SolverKind};
     use fibercell_solver::{CscMatrix, Ordering};
@@ -896,8 +894,15 @@ mod tests {
         }
     }
 
-    fn woodbury_solve_with(kind: SolverKind, forward: bool) {
-        let n = 60;
+    /// Entries (row, column, value) of a sparse test matrix.
+    type Triplets = Vec<(usize, usize, f64)>;
+
+    /// A path-graph Laplacian of order `n` plus a diagonal (its triplets), and its
+    /// factorization by `kind`.
+    pub(in crate::solve) fn path_graph_factor(
+        n: usize,
+        kind: SolverKind,
+    ) -> (Triplets, Box<dyn LinearSolver>) {
         let mut triplets = Vec::new();
         for i in 0..n {
             triplets.push((i, i, 3.0 + (i % 7) as f64 * 0.1));
@@ -910,6 +915,12 @@ mod tests {
         let mut solver = make_solver(kind, &Ordering::Auto, Vec::new()).expect("solver");
         solver.analyze(a0.as_ref()).expect("analyze");
         solver.factorize(a0.as_ref()).expect("factorize");
+        (triplets, solver)
+    }
+
+    fn woodbury_solve_with(kind: SolverKind, forward: bool) {
+        let n = 60;
+        let (triplets, mut solver) = path_graph_factor(n, kind);
         // A pseudo-random but fixed column for (contact, basis row).
         let column = |c: usize, k: usize| -> SparseColumn {
             (0..4)
