@@ -3,8 +3,9 @@
 //!
 //! On its own it runs each subtree task to its end, sums the tasks' updates of the top rows
 //! and runs the top blocks. A sparse forward solve advances the same cursors alongside its
-//! own blocks, so that a block of L its columns read is read for the right-hand side too while
-//! it is in cache (see [`crate::sparse_forward`]).
+//! own blocks and eliminates the right-hand side in the blocks its columns read as one more
+//! column of their kernels, so that those blocks of L are read once (see
+//! [`crate::sparse_forward`]).
 
 use crate::block_solve::{forward_block, top_par, Shared, SolveSchedule};
 use crate::sparse_forward::{BlockTree, NONE};
@@ -128,7 +129,6 @@ impl<'a> DenseForward<'a> {
 impl ForwardCursor<'_> {
     /// Eliminates the group's blocks before block `s` (all of them for [`NONE`]).
     pub(crate) fn advance_to(&mut self, s: usize) {
-        let top_index = self.schedule.top_index();
         while let Some(&t) = self.blocks.get(self.done).filter(|&&t| t < s) {
             self.done += 1;
             let b = self.tree.block(self.symbolic, self.values, t);
@@ -140,15 +140,51 @@ impl ForwardCursor<'_> {
                 Some(_) => Par::Seq,
                 None => top_par(&b, self.schedule),
             };
-            forward_block(&b, own, &mut self.below, par);
-            for (&row, v) in b.pattern.iter().zip(&self.below) {
-                match (
-                    &mut self.updates,
-                    top_index.get(row).copied().unwrap_or(NONE),
-                ) {
-                    (Some(update), k) if k != NONE => update[k] -= v,
-                    _ => unsafe { *self.x.at(row) -= v },
-                }
+            let mut below = std::mem::take(&mut self.below);
+            forward_block(&b, own, &mut below, par);
+            self.subtract(b.pattern, &below);
+            self.below = below;
+        }
+    }
+
+    /// The right-hand side's rows of block `s`, the group's next block, for a caller that
+    /// eliminates the block itself: it solves them in place and hands what its pattern rows
+    /// lose to [`ForwardCursor::eliminated`].
+    pub(crate) fn rows_of(&mut self, s: usize) -> &mut [f64] {
+        assert_eq!(
+            self.blocks.get(self.done),
+            Some(&s),
+            "block {s} is not next"
+        );
+        let b = &self.tree.shapes[s];
+        // SAFETY: as in `advance_to`: block `s` is the group's own.
+        unsafe { std::slice::from_raw_parts_mut(self.x.at(b.begin), b.width) }
+    }
+
+    /// Block `s` (see [`ForwardCursor::rows_of`]) eliminated by the caller: subtracts `below`,
+    /// its product with the block's rows below the diagonal, and moves past it.
+    pub(crate) fn eliminated(&mut self, s: usize, below: &[f64]) {
+        assert_eq!(
+            self.blocks.get(self.done),
+            Some(&s),
+            "block {s} is not next"
+        );
+        self.done += 1;
+        let b = self.tree.block(self.symbolic, self.values, s);
+        self.subtract(b.pattern, below);
+    }
+
+    /// x[pattern] −= below, a subtree task's top rows into its private updates.
+    fn subtract(&mut self, pattern: &[usize], below: &[f64]) {
+        let top_index = self.schedule.top_index();
+        for (&row, v) in pattern.iter().zip(below) {
+            match (
+                &mut self.updates,
+                top_index.get(row).copied().unwrap_or(NONE),
+            ) {
+                (Some(update), k) if k != NONE => update[k] -= v,
+                // SAFETY: as in `advance_to`.
+                _ => unsafe { *self.x.at(row) -= v },
             }
         }
     }
