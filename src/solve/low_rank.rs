@@ -158,8 +158,8 @@ enum CapacitanceFactor {
     /// definite I − Cᵀ S C by Cholesky, half the flops of an LU. C_c row-major per block.
     Cholesky {
         c: Vec<Vec<f64>>,
-        /// The factor L, column-major, order [`Capacitance::order`] (its lower triangle; the
-        /// strict upper one holds the matrix's entries, unused).
+        /// The factor L, column-major, order [`Capacitance::order`] (its lower triangle; above
+        /// it zeros, or within a contact's diagonal block the matrix's entries, unused).
         l: Vec<f64>,
     },
     /// Otherwise I + E S by LU with partial pivoting.
@@ -501,40 +501,52 @@ impl LowRankCorrection {
         c: &[Vec<f64>],
     ) -> Option<Vec<f64>> {
         let r = active.len();
-        // Column j of the matrix belongs to block b, local column a.
-        let owner: Vec<(usize, usize)> = blocks
-            .iter()
-            .enumerate()
-            .flat_map(|(b, (cols, _))| (0..cols.len()).map(move |a| (b, a)))
-            .collect();
         let mut data = vec![0.0; r * r];
-        data.par_chunks_mut(r.max(1))
-            .zip(&owner)
-            .enumerate()
-            .for_each(|(j, (out, &(b, a)))| {
-                let (cols_b, _) = &blocks[b];
+        // Each block's columns of the matrix, and where its rows begin.
+        let mut pieces: Vec<(&mut [f64], usize, usize)> = Vec::with_capacity(blocks.len());
+        let (mut rest, mut start) = (&mut data[..], 0);
+        for (b, (cols, _)) in blocks.iter().enumerate() {
+            let (now, next) = std::mem::take(&mut rest).split_at_mut(cols.len() * r);
+            pieces.push((now, start, b));
+            (rest, start) = (next, start + cols.len());
+        }
+        // The lower triangle, a block's columns at a time: S C_b on the active rows from the
+        // block's own on (S's columns of the block read once, gathered in the active order),
+        // then C_b1ᵀ of each row block b1 and the identity.
+        pieces.into_par_iter().zip(blocks).zip(c).for_each(
+            |(((out, start, b), (cols_b, _)), c_b)| {
                 let kb = cols_b.len();
-                // (S C) column j on the active rows.
-                let sc: Vec<f64> = active
-                    .iter()
-                    .map(|&row| {
-                        (0..kb)
-                            .map(|m| self.s[(row, cols_b[m])] * c[b][m * kb + a])
-                            .sum()
-                    })
-                    .collect();
-                let mut offset = 0;
-                for (b1, (cols, _)) in blocks.iter().enumerate() {
+                let rows = &active[start..];
+                let mut sc = vec![0.0; rows.len() * kb];
+                for (m, &col) in cols_b.iter().enumerate() {
+                    let s_col = self.s.col_as_slice(col);
+                    let gathered: Vec<f64> = rows.iter().map(|&row| s_col[row]).collect();
+                    for a in 0..kb {
+                        let weight = c_b[m * kb + a];
+                        let sc_a = &mut sc[a * rows.len()..(a + 1) * rows.len()];
+                        for (x, g) in sc_a.iter_mut().zip(&gathered) {
+                            *x += weight * g;
+                        }
+                    }
+                }
+                let mut offset = start;
+                for (b1, (cols, _)) in blocks.iter().enumerate().skip(b) {
                     let k = cols.len();
-                    for a1 in 0..k {
-                        out[offset + a1] = -(0..k)
-                            .map(|i| c[b1][i * k + a1] * sc[offset + i])
-                            .sum::<f64>();
+                    for a in 0..kb {
+                        let sc_a = &sc[a * rows.len() + offset - start..];
+                        let column = &mut out[a * r..(a + 1) * r];
+                        for a1 in 0..k {
+                            column[offset + a1] =
+                                -(0..k).map(|i| c[b1][i * k + a1] * sc_a[i]).sum::<f64>();
+                        }
                     }
                     offset += k;
                 }
-                out[j] += 1.0;
-            });
+                for a in 0..kb {
+                    out[a * r + start + a] += 1.0;
+                }
+            },
+        );
         let par = Par::rayon(0);
         let mut scratch =
             MemBuffer::new(cholesky_in_place_scratch::<f64>(r, par, Default::default()));
