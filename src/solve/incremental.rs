@@ -560,6 +560,45 @@ fn add_block_change(pair: &ContactPair, slots: &[u32], e: &BlockCoefficients, va
     }
 }
 
+/// Brings `values` to A₀'s values (`reference_values`) plus the blocks of `changes` when
+/// `behind`: the slots of the contacts changed since the reference (`changed`; every value
+/// when unknown) restored, then the changes added. The stick/slip iteration calls it only where
+/// the matrix is read, so iterations that neither check a residual nor factorize skip it.
+fn catch_up_values(
+    values: &mut [f64],
+    behind: &mut bool,
+    reference_values: &[f64],
+    pattern: &Pattern,
+    pairs: &[ContactPair],
+    changes: Option<&[ContactChange]>,
+    changed: &mut Option<Vec<usize>>,
+) {
+    let (true, Some(changes)) = (std::mem::take(behind), changes) else {
+        return;
+    };
+    match changed.take() {
+        Some(contacts) => {
+            for i in contacts {
+                for &slot in pattern.extra_slots(i) {
+                    if slot != NO_SLOT {
+                        values[slot as usize] = reference_values[slot as usize];
+                    }
+                }
+            }
+        }
+        None => values.copy_from_slice(reference_values),
+    }
+    *changed = Some(changes.iter().map(|ch| ch.contact).collect());
+    for ch in changes {
+        add_block_change(
+            &pairs[ch.contact],
+            pattern.extra_slots(ch.contact),
+            &ch.stiffness,
+            values,
+        );
+    }
+}
+
 /// The rows of `pair`'s block on free DOFs: (row in the block, free DOF).
 fn free_rows<'a>(
     pair: &'a ContactPair,
@@ -1088,29 +1127,10 @@ pub(crate) fn run_incremental(
                     })
                     .collect()
             });
-            if let Some(changes) = &changes {
-                match changed_since_reference.take() {
-                    Some(contacts) => {
-                        for i in contacts {
-                            for &slot in pattern.extra_slots(i) {
-                                if slot != NO_SLOT {
-                                    values[slot as usize] = reference_values[slot as usize];
-                                }
-                            }
-                        }
-                    }
-                    None => values.copy_from_slice(&reference_values),
-                }
-                changed_since_reference = Some(changes.iter().map(|ch| ch.contact).collect());
-                for ch in changes {
-                    add_block_change(
-                        &pairs[ch.contact],
-                        pattern.extra_slots(ch.contact),
-                        &ch.stiffness,
-                        &mut values,
-                    );
-                }
-            } else {
+            // With a reference, the values follow the changes only where the matrix is read
+            // (a residual check or a factorization): until then `values_behind`.
+            let mut values_behind = changes.is_some();
+            if changes.is_none() {
                 changed_since_reference = None;
                 values.copy_from_slice(&k_elastic);
             }
@@ -1282,7 +1302,6 @@ pub(crate) fn run_incremental(
             if disc.is_identity() {
                 check_supported_with(model, &closed)?;
             }
-            let a = pattern.matrix(&values)?;
             lap(&mut timings.assemble, &mut clock);
             // After the first factorization, solve on it with the changed contacts as a low-rank
             // correction while that is cheaper than refactorizing (see LowRankCost).
@@ -1292,12 +1311,7 @@ pub(crate) fn run_incremental(
             // consistent with it (the states in between only steer the iteration, and the
             // converged solution is checked as every other).
             let mut unchecked: Option<Capacitance> = None;
-            let check = ResidualCheck {
-                a,
-                symmetric: !nonsymmetric,
-                b: &rhs,
-                tolerance: REUSE_ACCURACY * backward_tolerance(&opts.solve),
-            };
+            let tolerance = REUSE_ACCURACY * backward_tolerance(&opts.solve);
             if let (Some(changes), Some(a0), true) = (
                 changes.as_ref(),
                 backends.reference.as_mut(),
@@ -1375,6 +1389,21 @@ pub(crate) fn run_incremental(
                             unchecked = Some(cap);
                         }
                         first => {
+                            catch_up_values(
+                                &mut values,
+                                &mut values_behind,
+                                &reference_values,
+                                &pattern,
+                                &pairs,
+                                Some(changes),
+                                &mut changed_since_reference,
+                            );
+                            let check = ResidualCheck {
+                                a: pattern.matrix(&values)?,
+                                symmetric: !nonsymmetric,
+                                b: &rhs,
+                                tolerance,
+                            };
                             reused = refine_low_rank(&low_rank, a0.as_mut(), &cap, &check, first)
                                 .map_err(locate)?;
                         }
@@ -1391,6 +1420,16 @@ pub(crate) fn run_incremental(
             } else {
                 // The first symmetric factorization, or the next after the correction outgrew its
                 // columns or its accuracy, becomes the reference (in its own solver).
+                catch_up_values(
+                    &mut values,
+                    &mut values_behind,
+                    &reference_values,
+                    &pattern,
+                    &pairs,
+                    changes.as_deref(),
+                    &mut changed_since_reference,
+                );
+                let a = pattern.matrix(&values)?;
                 let make_reference = !nonsymmetric
                     && low_rank_possible
                     && n_free > 0
@@ -1532,6 +1571,21 @@ pub(crate) fn run_incremental(
                     .reference
                     .as_mut()
                     .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "factorize")))?;
+                catch_up_values(
+                    &mut values,
+                    &mut values_behind,
+                    &reference_values,
+                    &pattern,
+                    &pairs,
+                    changes.as_deref(),
+                    &mut changed_since_reference,
+                );
+                let check = ResidualCheck {
+                    a: pattern.matrix(&values)?,
+                    symmetric: !nonsymmetric,
+                    b: &rhs,
+                    tolerance,
+                };
                 let checked =
                     refine_low_rank(&low_rank, a0.as_mut(), &cap, &check, Ok(x)).map_err(locate)?;
                 lap(&mut timings.factor_reuse, &mut clock);
