@@ -1312,6 +1312,32 @@ pub(crate) fn run_incremental(
             // converged solution is checked as every other).
             let mut unchecked: Option<Capacitance> = None;
             let tolerance = REUSE_ACCURACY * backward_tolerance(&opts.solve);
+            // The iteration's matrix, its values brought up to date first.
+            macro_rules! current_matrix {
+                () => {{
+                    catch_up_values(
+                        &mut values,
+                        &mut values_behind,
+                        &reference_values,
+                        &pattern,
+                        &pairs,
+                        changes.as_deref(),
+                        &mut changed_since_reference,
+                    );
+                    pattern.matrix(&values)?
+                }};
+            }
+            // The residual check of a low-rank solution against it.
+            macro_rules! residual_check {
+                () => {
+                    ResidualCheck {
+                        a: current_matrix!(),
+                        symmetric: !nonsymmetric,
+                        b: &rhs,
+                        tolerance,
+                    }
+                };
+            }
             if let (Some(changes), Some(a0), true) = (
                 changes.as_ref(),
                 backends.reference.as_mut(),
@@ -1389,21 +1415,7 @@ pub(crate) fn run_incremental(
                             unchecked = Some(cap);
                         }
                         first => {
-                            catch_up_values(
-                                &mut values,
-                                &mut values_behind,
-                                &reference_values,
-                                &pattern,
-                                &pairs,
-                                Some(changes),
-                                &mut changed_since_reference,
-                            );
-                            let check = ResidualCheck {
-                                a: pattern.matrix(&values)?,
-                                symmetric: !nonsymmetric,
-                                b: &rhs,
-                                tolerance,
-                            };
+                            let check = residual_check!();
                             reused = refine_low_rank(&low_rank, a0.as_mut(), &cap, &check, first)
                                 .map_err(locate)?;
                         }
@@ -1420,16 +1432,7 @@ pub(crate) fn run_incremental(
             } else {
                 // The first symmetric factorization, or the next after the correction outgrew its
                 // columns or its accuracy, becomes the reference (in its own solver).
-                catch_up_values(
-                    &mut values,
-                    &mut values_behind,
-                    &reference_values,
-                    &pattern,
-                    &pairs,
-                    changes.as_deref(),
-                    &mut changed_since_reference,
-                );
-                let a = pattern.matrix(&values)?;
+                let a = current_matrix!();
                 let make_reference = !nonsymmetric
                     && low_rank_possible
                     && n_free > 0
@@ -1571,21 +1574,7 @@ pub(crate) fn run_incremental(
                     .reference
                     .as_mut()
                     .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "factorize")))?;
-                catch_up_values(
-                    &mut values,
-                    &mut values_behind,
-                    &reference_values,
-                    &pattern,
-                    &pairs,
-                    changes.as_deref(),
-                    &mut changed_since_reference,
-                );
-                let check = ResidualCheck {
-                    a: pattern.matrix(&values)?,
-                    symmetric: !nonsymmetric,
-                    b: &rhs,
-                    tolerance,
-                };
+                let check = residual_check!();
                 let checked =
                     refine_low_rank(&low_rank, a0.as_mut(), &cap, &check, Ok(x)).map_err(locate)?;
                 lap(&mut timings.factor_reuse, &mut clock);
