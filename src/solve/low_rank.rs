@@ -503,24 +503,31 @@ impl LowRankCorrection {
         let r = active.len();
         let mut data = vec![0.0; r * r];
         // Each block's columns of the matrix, and where its rows begin.
-        let mut pieces: Vec<(&mut [f64], usize, usize)> = Vec::with_capacity(blocks.len());
+        let mut pieces: Vec<(&mut [f64], usize)> = Vec::with_capacity(blocks.len());
         let (mut rest, mut start) = (&mut data[..], 0);
-        for (b, (cols, _)) in blocks.iter().enumerate() {
+        for (cols, _) in blocks {
             let (now, next) = std::mem::take(&mut rest).split_at_mut(cols.len() * r);
-            pieces.push((now, start, b));
+            pieces.push((now, start));
             (rest, start) = (next, start + cols.len());
         }
         // The lower triangle, a block's columns at a time: S C_b on the active rows from the
         // block's own on (S's columns of the block read once, gathered in the active order),
         // then C_b1ᵀ of each row block b1 and the identity.
-        pieces.into_par_iter().zip(blocks).zip(c).for_each(
-            |(((out, start, b), (cols_b, _)), c_b)| {
+        pieces
+            .into_par_iter()
+            .zip(blocks)
+            .zip(c)
+            .enumerate()
+            .for_each(|(b, (((out, start), (cols_b, _)), c_b))| {
                 let kb = cols_b.len();
                 let rows = &active[start..];
                 let mut sc = vec![0.0; rows.len() * kb];
+                let mut gathered = vec![0.0; rows.len()];
                 for (m, &col) in cols_b.iter().enumerate() {
                     let s_col = self.s.col_as_slice(col);
-                    let gathered: Vec<f64> = rows.iter().map(|&row| s_col[row]).collect();
+                    for (g, &row) in gathered.iter_mut().zip(rows) {
+                        *g = s_col[row];
+                    }
                     for a in 0..kb {
                         let weight = c_b[m * kb + a];
                         let sc_a = &mut sc[a * rows.len()..(a + 1) * rows.len()];
@@ -545,8 +552,7 @@ impl LowRankCorrection {
                 for a in 0..kb {
                     out[a * r + start + a] += 1.0;
                 }
-            },
-        );
+            });
         let par = Par::rayon(0);
         let mut scratch =
             MemBuffer::new(cholesky_in_place_scratch::<f64>(r, par, Default::default()));

@@ -545,9 +545,6 @@ impl Walk<'_> {
                 _ => 1,
             };
             let (w, p) = (b.width, b.pattern.len());
-            let solve = |x: &mut [f64], out: &mut [f64], low: usize, dense: bool| {
-                eliminate_columns(top, bottom, x, out, low, dense)
-            };
             let layout = self.layouts[k].as_ref();
             let one = [(0..m, 0)];
             let groups = layout.map_or(&one[..], |l| &l.groups[..]);
@@ -579,11 +576,13 @@ impl Walk<'_> {
                 items
                     .into_par_iter()
                     .with_max_len(1)
-                    .for_each(|(x, out, low, dense)| solve(x, out, low, dense));
+                    .for_each(|(x, out, low, dense)| {
+                        eliminate_columns(top, bottom, x, out, low, dense)
+                    });
             } else {
-                items
-                    .into_iter()
-                    .for_each(|(x, out, low, dense)| solve(x, out, low, dense));
+                items.into_iter().for_each(|(x, out, low, dense)| {
+                    eliminate_columns(top, bottom, x, out, low, dense)
+                });
             }
             if let Some(c) = cursor.as_deref_mut() {
                 c.rows_of(s).copy_from_slice(&xs[m * w..]);
