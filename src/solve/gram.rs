@@ -1,11 +1,13 @@
 //! The new columns of a Gram matrix Wᵀ W for one block of forward-solved columns, by panels:
 //! each product starts at the first row its panel's columns can be nonzero in, and the product
-//! of the new columns with themselves is formed once per pair of panels and mirrored.
+//! of the new columns with themselves is formed once per pair of panels (a panel with itself:
+//! its lower triangle) and mirrored.
 //!
 //! Blocks store their columns grouped by first nonzero row where that saves flops (the faer
 //! backend's column layout), so the panels of a root separator's columns begin far down: on the
 //! L bench cell at 1 % this halves the root's 3.8 GFLOP Gram product.
 
+use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::{Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
@@ -62,18 +64,29 @@ pub(crate) fn new_gram_columns(w: MatRef<'_, f64>, old: usize, threads: usize) -
             });
         }
     }
+    // A panel against itself: its lower triangle only (mirrored below).
     let multiply = |p: &Piece| {
         let (m, n) = (p.left.len(), p.right.len());
         let mut out = vec![0.0; m * n];
         let tail = rows - p.from;
-        faer::linalg::matmul::matmul(
-            MatMut::from_column_major_slice_mut(&mut out, m, n),
-            Accum::Replace,
-            w.submatrix(p.from, p.left.start, tail, m).transpose(),
-            w.submatrix(p.from, p.right.start, tail, n),
-            1.0,
-            Par::Seq,
-        );
+        let dst = MatMut::from_column_major_slice_mut(&mut out, m, n);
+        let lhs = w.submatrix(p.from, p.left.start, tail, m).transpose();
+        let rhs = w.submatrix(p.from, p.right.start, tail, n);
+        if p.left == p.right {
+            triangular::matmul(
+                dst,
+                BlockStructure::TriangularLower,
+                Accum::Replace,
+                lhs,
+                BlockStructure::Rectangular,
+                rhs,
+                BlockStructure::Rectangular,
+                1.0,
+                Par::Seq,
+            );
+        } else {
+            faer::linalg::matmul::matmul(dst, Accum::Replace, lhs, rhs, 1.0, Par::Seq);
+        }
         out
     };
     let results: Vec<Vec<f64>> = if threads > 1 {
@@ -83,13 +96,16 @@ pub(crate) fn new_gram_columns(w: MatRef<'_, f64>, old: usize, threads: usize) -
     };
     for (p, out) in pieces.iter().zip(results) {
         let m = p.left.len();
+        let diagonal = p.left == p.right;
         for (b, col) in out.chunks(m).enumerate() {
             let c = p.right.start + b - old;
-            for (a, &v) in col.iter().enumerate() {
+            // A diagonal piece holds its lower triangle.
+            let lowest = if diagonal { b } else { 0 };
+            for (a, &v) in col.iter().enumerate().skip(lowest) {
                 let row = p.left.start + a;
                 product[c * all + row] = v;
-                // The mirror of a pair of distinct new panels.
-                if row >= old && p.left != p.right {
+                // The mirror of a pair of new columns.
+                if row >= old {
                     product[(row - old) * all + p.right.start + b] = v;
                 }
             }

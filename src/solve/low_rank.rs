@@ -385,6 +385,7 @@ impl LowRankCorrection {
         let ColumnMode::Forward(store) = &mut self.mode else {
             return;
         };
+        let end = start + w.ncols;
         // Each block's new columns appended (a new block takes the solved values as they are).
         let mut updated = Vec::with_capacity(w.blocks.len());
         for blk in w.blocks {
@@ -418,18 +419,35 @@ impl LowRankCorrection {
                 new_gram_columns(w_all, old, threads)
             })
             .collect();
-        for (&(block, old), product) in updated.iter().zip(products) {
-            let stored = &store[&block];
-            let all = stored.columns.len();
-            for (b, p) in product.chunks(all).enumerate() {
-                let col = stored.columns[old + b];
-                for (a, &v) in p.iter().enumerate() {
-                    let row = stored.columns[a];
-                    self.s[(row, col)] += v;
-                    if a < old {
-                        self.s[(col, row)] += v;
+        // The new columns of S summed on the threads, one column each: the products' columns
+        // that add to it, in block order.
+        let mut parts: Vec<Vec<(usize, usize)>> = vec![Vec::new(); end - start];
+        for (i, &(block, old)) in updated.iter().enumerate() {
+            for (b, &col) in store[&block].columns[old..].iter().enumerate() {
+                parts[col - start].push((i, b));
+            }
+        }
+        let r = self.s.nrows();
+        let mut fresh = vec![0.0; r * (end - start)];
+        fresh
+            .par_chunks_mut(r)
+            .zip(&parts)
+            .for_each(|(out, parts)| {
+                for &(i, b) in parts {
+                    let columns = &store[&updated[i].0].columns;
+                    let all = columns.len();
+                    for (&row, &v) in columns.iter().zip(&products[i][b * all..(b + 1) * all]) {
+                        out[row] += v;
                     }
                 }
+            });
+        // Nothing was in the new columns before; their rows of the older columns mirror them.
+        for (c, column) in (start..end).zip(fresh.chunks(r)) {
+            self.s.col_as_slice_mut(c).copy_from_slice(column);
+        }
+        for c in start..end {
+            for row in 0..start {
+                self.s[(c, row)] = self.s[(row, c)];
             }
         }
     }
@@ -748,26 +766,31 @@ impl LowRankCorrection {
         let known = projection.len();
         projection.resize(self.columns.len(), 0.0);
         if let ColumnMode::Forward(store) = &self.mode {
-            // One buffer for every block's products.
-            let mut products = Vec::new();
-            for blk in store.values() {
-                let new = blk.columns.partition_point(|&c| c < known);
-                debug_assert!(blk.columns[new..].iter().all(|&c| c >= known));
-                if new == blk.columns.len() {
-                    continue;
-                }
-                let rows = &f[blk.first_row..blk.first_row + blk.rows];
-                let w = blk.matrix().subcols(new, blk.columns.len() - new);
-                products.resize(w.ncols(), 0.0);
-                matmul(
-                    MatMut::from_column_major_slice_mut(&mut products, w.ncols(), 1),
-                    Accum::Replace,
-                    w.transpose(),
-                    MatRef::from_column_major_slice(rows, blk.rows, 1),
-                    1.0,
-                    blk.par(),
-                );
-                for (&c, p) in blk.columns[new..].iter().zip(&products) {
+            // The blocks' products on the threads, summed per column after.
+            let products: Vec<(&[usize], Vec<f64>)> = store
+                .par_iter()
+                .filter_map(|(_, blk)| {
+                    let new = blk.columns.partition_point(|&c| c < known);
+                    debug_assert!(blk.columns[new..].iter().all(|&c| c >= known));
+                    if new == blk.columns.len() {
+                        return None;
+                    }
+                    let rows = &f[blk.first_row..blk.first_row + blk.rows];
+                    let w = blk.matrix().subcols(new, blk.columns.len() - new);
+                    let mut products = vec![0.0; w.ncols()];
+                    matmul(
+                        MatMut::from_column_major_slice_mut(&mut products, w.ncols(), 1),
+                        Accum::Replace,
+                        w.transpose(),
+                        MatRef::from_column_major_slice(rows, blk.rows, 1),
+                        1.0,
+                        blk.par(),
+                    );
+                    Some((&blk.columns[new..], products))
+                })
+                .collect();
+            for (columns, products) in products {
+                for (&c, p) in columns.iter().zip(&products) {
                     projection[c] += p;
                 }
             }
@@ -778,27 +801,31 @@ impl LowRankCorrection {
     /// solves.
     fn forward_spread(&self, v: &[f64], out: &mut [f64]) {
         if let ColumnMode::Forward(store) = &self.mode {
-            // One buffer for every block's coefficients.
-            let mut coefficients = Vec::new();
-            for blk in store.values() {
-                coefficients.clear();
-                coefficients.extend(blk.columns.iter().map(|&c| v[c]));
+            // The blocks' rows are disjoint: split `out` by them, the products on the threads.
+            let mut blocks: Vec<&StoredBlock> = store.values().collect();
+            blocks.sort_unstable_by_key(|blk| blk.first_row);
+            let mut pieces = Vec::with_capacity(blocks.len());
+            let (mut rest, mut at) = (out, 0);
+            for blk in blocks {
+                let (_, tail) = std::mem::take(&mut rest).split_at_mut(blk.first_row - at);
+                let (rows, tail) = tail.split_at_mut(blk.rows);
+                pieces.push((blk, rows));
+                (rest, at) = (tail, blk.first_row + blk.rows);
+            }
+            pieces.into_par_iter().for_each(|(blk, rows)| {
+                let coefficients: Vec<f64> = blk.columns.iter().map(|&c| v[c]).collect();
                 if coefficients.iter().all(|&x| x == 0.0) {
-                    continue;
+                    return;
                 }
                 matmul(
-                    MatMut::from_column_major_slice_mut(
-                        &mut out[blk.first_row..blk.first_row + blk.rows],
-                        blk.rows,
-                        1,
-                    ),
+                    MatMut::from_column_major_slice_mut(rows, blk.rows, 1),
                     Accum::Add,
                     blk.matrix(),
                     MatRef::from_column_major_slice(&coefficients, blk.columns.len(), 1),
                     1.0,
                     blk.par(),
                 );
-            }
+            });
         }
     }
 }

@@ -204,14 +204,16 @@ impl BlockTree {
             .iter()
             .map(|&s| self.shapes[s].width * members[s].len())
             .collect();
-        // Room for a dense right-hand side's rows (see `Walk::eliminate`).
+        // Room for a dense right-hand side's rows (see `Walk::eliminate`). Allocated zeroed
+        // (`vec!`), so that large blocks' pages are zeroed where the walk first touches them,
+        // on the threads, instead of written here.
         let spare = |s: usize| rhs.as_ref().map_or(0, |_| self.shapes[s].width);
         let mut x: Vec<Vec<f64>> = touched
             .iter()
             .zip(&x_len)
             .map(|(&s, &n)| {
-                let mut xs = Vec::with_capacity(n + spare(s));
-                xs.resize(n, 0.0);
+                let mut xs = vec![0.0; n + spare(s)];
+                xs.truncate(n);
                 xs
             })
             .collect();
