@@ -8,6 +8,7 @@
 //! backward, the top blocks first, then the subtrees in parallel (they only read the top rows).
 
 use crate::dense_forward::DenseForward;
+use crate::prefetch::prefetch_start;
 use crate::sparse_forward::{Block, BlockTree, NONE};
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
@@ -335,7 +336,10 @@ pub(crate) fn backward_in_place(
     let shared = Shared(x.as_mut_ptr());
     schedule.tasks.par_iter().for_each(|blocks| {
         let mut below = Vec::new();
-        for &s in blocks.iter().rev() {
+        for (i, &s) in blocks.iter().enumerate().rev() {
+            if let Some(&next) = i.checked_sub(1).map(|j| &blocks[j]) {
+                prefetch_start(&values[tree.shapes[next].values.clone()]);
+            }
             let b = tree.block(symbolic, values, s);
             below.clear();
             // SAFETY: the pattern rows are this task's (written by it before) or top rows

@@ -8,6 +8,7 @@
 //! [`crate::sparse_forward`]).
 
 use crate::block_solve::{forward_block, top_par, Shared, SolveSchedule};
+use crate::prefetch::prefetch_start;
 use crate::sparse_forward::{BlockTree, NONE};
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::Par;
@@ -131,6 +132,9 @@ impl ForwardCursor<'_> {
     pub(crate) fn advance_to(&mut self, s: usize) {
         while let Some(&t) = self.blocks.get(self.done).filter(|&&t| t < s) {
             self.done += 1;
+            if let Some(&next) = self.blocks.get(self.done) {
+                prefetch_start(&self.values[self.tree.shapes[next].values.clone()]);
+            }
             let b = self.tree.block(self.symbolic, self.values, t);
             // SAFETY: a task's blocks and the rows below them that are not top rows lie in its
             // subtrees, which no other cursor writes while the tasks run; top rows go to its

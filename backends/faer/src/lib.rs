@@ -9,6 +9,7 @@ mod dense_forward;
 mod lu;
 mod permute;
 mod pivots;
+mod prefetch;
 mod sparse_forward;
 mod top_columns;
 
