@@ -405,10 +405,14 @@ impl LowRankCorrection {
             updated.push((blk.block, old));
         }
         let store = &*store;
+        // The updated blocks, each looked up once.
+        let updated: Vec<(&StoredBlock, usize)> = updated
+            .into_iter()
+            .map(|(block, old)| (&store[&block], old))
+            .collect();
         let products: Vec<Vec<f64>> = updated
             .par_iter()
-            .map(|&(block, old)| {
-                let stored = &store[&block];
+            .map(|&(stored, old)| {
                 let (rows, all) = (stored.rows, stored.columns.len());
                 let w_all = MatRef::from_column_major_slice(&stored.values, rows, all);
                 let threads = if rows * all * (all - old) > PARALLEL_PRODUCT {
@@ -422,8 +426,8 @@ impl LowRankCorrection {
         // The new columns of S summed on the threads, one column each: the products' columns
         // that add to it, in block order.
         let mut parts: Vec<Vec<(usize, usize)>> = vec![Vec::new(); end - start];
-        for (i, &(block, old)) in updated.iter().enumerate() {
-            for (b, &col) in store[&block].columns[old..].iter().enumerate() {
+        for (i, &(stored, old)) in updated.iter().enumerate() {
+            for (b, &col) in stored.columns[old..].iter().enumerate() {
                 parts[col - start].push((i, b));
             }
         }
@@ -434,7 +438,7 @@ impl LowRankCorrection {
             .zip(&parts)
             .for_each(|(out, parts)| {
                 for &(i, b) in parts {
-                    let columns = &store[&updated[i].0].columns;
+                    let columns = &updated[i].0.columns;
                     let all = columns.len();
                     for (&row, &v) in columns.iter().zip(&products[i][b * all..(b + 1) * all]) {
                         out[row] += v;

@@ -8,7 +8,7 @@
 //! backward, the top blocks first, then the subtrees in parallel (they only read the top rows).
 
 use crate::dense_forward::DenseForward;
-use crate::prefetch::prefetch_start;
+use crate::prefetch::prefetch_block;
 use crate::sparse_forward::{Block, BlockTree, NONE};
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
@@ -337,8 +337,8 @@ pub(crate) fn backward_in_place(
     schedule.tasks.par_iter().for_each(|blocks| {
         let mut below = Vec::new();
         for (i, &s) in blocks.iter().enumerate().rev() {
-            if let Some(&next) = i.checked_sub(1).map(|j| &blocks[j]) {
-                prefetch_start(&values[tree.shapes[next].values.clone()]);
+            if i > 0 {
+                prefetch_block(tree, values, blocks[i - 1]);
             }
             let b = tree.block(symbolic, values, s);
             below.clear();

@@ -8,7 +8,7 @@
 //! [`crate::sparse_forward`]).
 
 use crate::block_solve::{forward_block, top_par, Shared, SolveSchedule};
-use crate::prefetch::prefetch_start;
+use crate::prefetch::prefetch_block;
 use crate::sparse_forward::{BlockTree, NONE};
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::Par;
@@ -133,7 +133,7 @@ impl ForwardCursor<'_> {
         while let Some(&t) = self.blocks.get(self.done).filter(|&&t| t < s) {
             self.done += 1;
             if let Some(&next) = self.blocks.get(self.done) {
-                prefetch_start(&self.values[self.tree.shapes[next].values.clone()]);
+                prefetch_block(self.tree, self.values, next);
             }
             let b = self.tree.block(self.symbolic, self.values, t);
             // SAFETY: a task's blocks and the rows below them that are not top rows lie in its
@@ -155,11 +155,7 @@ impl ForwardCursor<'_> {
     /// eliminates the block itself: it solves them in place and hands what its pattern rows
     /// lose to [`ForwardCursor::eliminated`].
     pub(crate) fn rows_of(&mut self, s: usize) -> &mut [f64] {
-        assert_eq!(
-            self.blocks.get(self.done),
-            Some(&s),
-            "block {s} is not next"
-        );
+        self.assert_next(s);
         let b = &self.tree.shapes[s];
         // SAFETY: as in `advance_to`: block `s` is the group's own.
         unsafe { std::slice::from_raw_parts_mut(self.x.at(b.begin), b.width) }
@@ -168,14 +164,19 @@ impl ForwardCursor<'_> {
     /// Block `s` (see [`ForwardCursor::rows_of`]) eliminated by the caller: subtracts `below`,
     /// its product with the block's rows below the diagonal, and moves past it.
     pub(crate) fn eliminated(&mut self, s: usize, below: &[f64]) {
+        self.assert_next(s);
+        self.done += 1;
+        let b = self.tree.block(self.symbolic, self.values, s);
+        self.subtract(b.pattern, below);
+    }
+
+    /// Panics unless block `s` is the group's next (a caller's walk out of step).
+    fn assert_next(&self, s: usize) {
         assert_eq!(
             self.blocks.get(self.done),
             Some(&s),
             "block {s} is not next"
         );
-        self.done += 1;
-        let b = self.tree.block(self.symbolic, self.values, s);
-        self.subtract(b.pattern, below);
     }
 
     /// x[pattern] −= below, a subtree task's top rows into its private updates.
