@@ -139,7 +139,7 @@ impl LinearSolver for Cholmod {
     }
 
     fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError> {
-        <dyn LinearSolver>::check_matrix(a, None)?;
+        <dyn LinearSolver>::check_symmetric_matrix(a)?;
         self.free_factor();
         self.state = None;
         if self.common.is_none() {

@@ -214,6 +214,40 @@ impl<'a> CscRef<'a> {
         self.values.iter().position(|v| !v.is_finite())
     }
 
+    /// The first stored entry (row, column) whose mirror (column, row) is not stored, in
+    /// column order; `None` for a structurally symmetric square matrix. Columns are checked
+    /// in parallel by binary search, O(nnz log(nnz per column)).
+    pub fn structural_asymmetry(&self) -> Option<(usize, usize)> {
+        if self.nrows != self.ncols {
+            return Some((self.nrows.min(self.ncols), 0));
+        }
+        (0..self.ncols)
+            .into_par_iter()
+            .with_min_len(1024)
+            .find_map_first(|j| {
+                self.col(j)
+                    .0
+                    .iter()
+                    .find(|&&i| self.col(i).0.binary_search(&j).is_err())
+                    .map(|&i| (i, j))
+            })
+    }
+
+    /// Checks that the matrix is square with a symmetric pattern (what symmetric backends and
+    /// the fill-reducing orderings need).
+    pub fn check_structurally_symmetric(&self) -> Result<(), SolverError> {
+        if self.nrows != self.ncols {
+            return Err(SolverError::DimensionMismatch(format!(
+                "matrix is {}×{}, not square",
+                self.nrows, self.ncols
+            )));
+        }
+        match self.structural_asymmetry() {
+            None => Ok(()),
+            Some((row, column)) => Err(SolverError::NotStructurallySymmetric { row, column }),
+        }
+    }
+
     /// Whether `|a_ij − a_ji| ≤ tol · max|a|` for all entries (pattern must be symmetric too).
     pub fn is_symmetric(&self, tol: f64) -> bool {
         if self.nrows != self.ncols {
@@ -342,6 +376,40 @@ impl CscMatrix {
             col_ptr[j + 1] += col_ptr[j];
         }
         Self::new(nrows, ncols, col_ptr, row_idx, values)
+    }
+
+    /// The full symmetric matrix A + Aᵀ − diag(A) of a matrix that stores one triangle of it
+    /// (lower or upper, with its diagonal): what a symmetric Matrix Market file or
+    /// `scipy.sparse.tril` gives. A matrix with entries in both strict triangles is refused
+    /// ([`SolverError::InvalidMatrix`]): it is not a triangle.
+    pub fn symmetric_from_triangle(a: CscRef<'_>) -> Result<Self, SolverError> {
+        if a.nrows() != a.ncols() {
+            return Err(SolverError::DimensionMismatch(format!(
+                "matrix is {}×{}, not square",
+                a.nrows(),
+                a.ncols()
+            )));
+        }
+        let (mut lower, mut upper) = (false, false);
+        let mut t = Vec::with_capacity(2 * a.nnz());
+        for j in 0..a.ncols() {
+            let (rows, vals) = a.col(j);
+            for (&i, &v) in rows.iter().zip(vals) {
+                lower |= i > j;
+                upper |= i < j;
+                t.push((i, j, v));
+                if i != j {
+                    t.push((j, i, v));
+                }
+            }
+        }
+        if lower && upper {
+            return Err(SolverError::InvalidMatrix(
+                "entries in both strict triangles: not a single triangle of a symmetric matrix"
+                    .into(),
+            ));
+        }
+        Self::from_triplets(a.nrows(), a.ncols(), &t)
     }
 
     /// Copies any sprs matrix (CSR or CSC, sliced or not) into CSC form.

@@ -81,6 +81,16 @@ pub enum SolverError {
         /// Position (value index for the matrix, row for vectors).
         index: usize,
     },
+    /// A symmetric backend or ordering got a matrix whose pattern is not symmetric: entry
+    /// (`row`, `column`) is stored but (`column`, `row`) is not — typically one triangle of a
+    /// symmetric matrix (a symmetric Matrix Market file, `scipy.sparse.tril`).
+    #[error("the sparsity pattern is not symmetric: entry ({row}, {column}) is stored but ({column}, {row}) is not; symmetric matrices must store both triangles (expand a single triangle with CscMatrix::symmetric_from_triangle)")]
+    NotStructurallySymmetric {
+        /// Row of the unmatched entry.
+        row: usize,
+        /// Column of the unmatched entry.
+        column: usize,
+    },
     /// The backend only handles symmetric matrices.
     #[error("backend {0} needs a symmetric matrix")]
     NotSymmetric(&'static str),

@@ -77,11 +77,21 @@ impl Permutation {
     }
 }
 
-/// Computes the permutation for a concrete ordering from the pattern of the (square,
-/// structurally symmetric) matrix `a`. [`Ordering::Auto`] is resolved by the backends; here it
+/// Computes the permutation for a concrete ordering from the pattern of the square,
+/// structurally symmetric matrix `a` (checked: AMD and METIS need a symmetric graph and hang or
+/// return nonsense on one triangle). [`Ordering::Auto`] is resolved by the backends; here it
 /// means AMD.
 pub fn compute_ordering(a: CscRef<'_>, ordering: &Ordering) -> Result<Permutation, SolverError> {
     let n = a.ncols();
+    if a.nrows() != n {
+        return Err(SolverError::DimensionMismatch(format!(
+            "matrix is {}×{n}, not square",
+            a.nrows()
+        )));
+    }
+    if !matches!(ordering, Ordering::Given(_) | Ordering::Natural) {
+        a.check_structurally_symmetric()?;
+    }
     match ordering {
         Ordering::Natural => Ok(Permutation::identity(n)),
         Ordering::Given(p) => Permutation::from_fwd(p.clone(), n),
@@ -126,6 +136,22 @@ fn supervariables(a: CscRef<'_>) -> (Vec<usize>, Vec<usize>) {
         *g = starts.len() - 1;
     }
     (group, starts)
+}
+
+/// The typed error of a METIS return code other than METIS_OK.
+fn metis_error(status: metis_sys::rstatus_et) -> SolverError {
+    #[allow(non_upper_case_globals)]
+    match status {
+        metis_sys::rstatus_et_METIS_ERROR_MEMORY => SolverError::OutOfMemory,
+        metis_sys::rstatus_et_METIS_ERROR_INPUT => SolverError::InvalidMatrix(
+            "METIS_NodeND rejected the graph of the matrix (METIS_ERROR_INPUT)".into(),
+        ),
+        code => SolverError::Backend {
+            backend: "metis",
+            code: code as i64,
+            message: "METIS_NodeND failed (METIS_ERROR)".into(),
+        },
+    }
 }
 
 /// METIS_OPTION_NSEPS of the nested dissection.
@@ -193,11 +219,7 @@ fn nested_dissection(a: CscRef<'_>) -> Result<Permutation, SolverError> {
         )
     };
     if status != metis_sys::rstatus_et_METIS_OK {
-        return Err(SolverError::Backend {
-            backend: "metis",
-            code: status as i64,
-            message: "METIS_NodeND failed".into(),
-        });
+        return Err(metis_error(status));
     }
     // Expand: supervariables in METIS order, their columns consecutively.
     let mut fwd = Vec::with_capacity(n);

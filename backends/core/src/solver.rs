@@ -149,6 +149,14 @@ impl dyn LinearSolver {
         Ok(())
     }
 
+    /// [`Self::check_matrix`] plus a symmetric pattern: what every symmetric backend checks in
+    /// `analyze` before it orders (a single triangle would otherwise be ordered and factorized
+    /// as if it were the whole matrix).
+    pub fn check_symmetric_matrix(a: CscRef<'_>) -> Result<(), SolverError> {
+        Self::check_matrix(a, None)?;
+        a.check_structurally_symmetric()
+    }
+
     /// Checks that the matrix is square, of order `n` when given, with finite values.
     pub fn check_matrix(a: CscRef<'_>, n: Option<usize>) -> Result<(), SolverError> {
         if a.nrows() != a.ncols() {

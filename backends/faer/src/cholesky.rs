@@ -209,7 +209,7 @@ impl LinearSolver for FaerCholesky {
     }
 
     fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError> {
-        <dyn LinearSolver>::check_matrix(a, None)?;
+        <dyn LinearSolver>::check_symmetric_matrix(a)?;
         self.factor = None;
         self.analysis = None;
         let n = a.ncols();
