@@ -11,9 +11,9 @@ use fibercell::cell::pair_boundary_nodes;
 use fibercell::contact::find_candidates;
 use fibercell::generate::{nonwoven, nonwoven_preset};
 use fibercell::homogenize::{ContactStiffness, PeriodicSystem};
-use fibercell::solve::{make_solver, SolverKind};
+use fibercell::solve::{SolverConfig, SolverKind};
 use fibercell::Model;
-use fibercell_solver::{pcg_with_factor, Ordering};
+use fibercell_solver::pcg_with_factor;
 use std::hint::black_box;
 
 fn stages(c: &mut Criterion) {
@@ -58,15 +58,16 @@ fn stages(c: &mut Criterion) {
             kinds.push(("cholmod", SolverKind::Cholmod));
         }
         for (name, kind) in kinds {
-            let mut solver = make_solver(kind, &Ordering::Auto, Vec::new()).expect("backend");
+            let mut solver = SolverConfig::new(kind).build().expect("backend");
             solver.analyze(a).expect("analysis");
             g.bench_function(format!("factorize {name}/{size}"), |b| {
                 b.iter(|| solver.factorize(a).expect("factorization"))
             });
         }
 
-        let mut factor =
-            make_solver(SolverKind::FaerCholesky, &Ordering::Auto, Vec::new()).expect("faer");
+        let mut factor = SolverConfig::new(SolverKind::FaerCholesky)
+            .build()
+            .expect("faer");
         factor.analyze(a).expect("analysis");
         factor.factorize(a).expect("factorization");
         let mut switched = sys.zero_values();
@@ -86,7 +87,7 @@ fn stages(c: &mut Criterion) {
                 black_box(r.iterations)
             })
         });
-        if let Ok(mut chol) = make_solver(SolverKind::Cholmod, &Ordering::Auto, Vec::new()) {
+        if let Ok(mut chol) = SolverConfig::new(SolverKind::Cholmod).build() {
             // The switch as a rank-2 downdate of CHOLMOD's factor, a solve, and the update
             // back (the factor stays simplicial after the first modification).
             let w = sys.stick_spring_matrix(&[0]).expect("columns");

@@ -20,18 +20,38 @@ struct Cli {
     command: Command,
 }
 
+/// The linear solver of every command that solves.
+#[derive(clap::Args, Clone, Debug)]
+struct SolverArgs {
+    /// Linear solver backend (cholmod needs a build with `--features cholmod`); systems that
+    /// sliding Coulomb contacts make nonsymmetric go to faer-lu whatever is chosen.
+    #[arg(long, default_value = "faer-cholesky", value_parser = solver_parser())]
+    solver: SolverKind,
+    /// Fill-reducing ordering of the Cholesky backends: auto (the better of amd and nd by
+    /// predicted flops), amd, nd (nested dissection, METIS) or natural.
+    #[arg(long, default_value = "auto", value_parser = ordering_parser())]
+    ordering: Ordering,
+}
+
+impl SolverArgs {
+    /// The library's options for these flags.
+    fn options(&self) -> SolveOptions {
+        SolveOptions {
+            solver: self.solver,
+            ordering: self.ordering.clone(),
+            ..SolveOptions::default()
+        }
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Solve the linear static problem of a model (supports and nodal loads from the file).
     Solve {
         /// Model file: .toml, .json or Abaqus .inp.
         model: PathBuf,
-        /// Linear solver backend.
-        #[arg(long, default_value = "faer-cholesky", value_parser = parse_solver)]
-        solver: SolverKind,
-        /// Fill-reducing ordering: auto, amd, nd (nested dissection, METIS) or natural.
-        #[arg(long, default_value = "auto", value_parser = parse_ordering)]
-        ordering: Ordering,
+        #[command(flatten)]
+        solver: SolverArgs,
         /// Print one JSON document (displacements, reactions, solver report) to stdout.
         #[arg(long)]
         json: bool,
@@ -51,9 +71,8 @@ enum Command {
     Homogenize {
         /// Model file with a [cell] section.
         model: PathBuf,
-        /// Linear solver backend.
-        #[arg(long, default_value = "faer-cholesky", value_parser = parse_solver)]
-        solver: SolverKind,
+        #[command(flatten)]
+        solver: SolverArgs,
         /// Print one JSON document instead of the table.
         #[arg(long)]
         json: bool,
@@ -75,9 +94,8 @@ enum Command {
         /// Unload to zero and reload (hysteresis).
         #[arg(long)]
         unload: bool,
-        /// Linear solver backend for the symmetric systems.
-        #[arg(long, default_value = "faer-cholesky", value_parser = parse_solver)]
-        solver: SolverKind,
+        #[command(flatten)]
+        solver: SolverArgs,
         /// Print one JSON document.
         #[arg(long)]
         json: bool,
@@ -361,24 +379,29 @@ fn parse_orientation(s: &str) -> Result<fibercell::generate::Orientation, String
     }
 }
 
-fn parse_solver(s: &str) -> Result<SolverKind, String> {
-    s.parse()
+/// `--solver`: the backends' names, listed in `--help`.
+fn solver_parser() -> impl clap::builder::TypedValueParser<Value = SolverKind> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(SolverKind::ALL.map(SolverKind::name))
+        .try_map(|s| s.parse::<SolverKind>())
+}
+
+/// `--ordering`: the orderings' names, listed in `--help`.
+fn ordering_parser() -> impl clap::builder::TypedValueParser<Value = Ordering> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(["auto", "amd", "nd", "natural"]).try_map(|s| match s
+        .as_str()
+    {
+        "auto" => Ok(Ordering::Auto),
+        "amd" => Ok(Ordering::Amd),
+        "nd" => Ok(Ordering::NestedDissection),
+        "natural" => Ok(Ordering::Natural),
+        _ => Err(format!("unknown ordering \"{s}\"")),
+    })
 }
 
 fn parse_strain(s: &str) -> Result<fibercell::cell::MacroStrain, String> {
     fibercell::cell::parse_macro_strain(s)
-}
-
-fn parse_ordering(s: &str) -> Result<Ordering, String> {
-    match s {
-        "auto" => Ok(Ordering::Auto),
-        "amd" => Ok(Ordering::Amd),
-        "nd" | "nested-dissection" | "metis" => Ok(Ordering::NestedDissection),
-        "natural" => Ok(Ordering::Natural),
-        _ => Err(format!(
-            "unknown ordering \"{s}\" (use auto, amd, nd or natural)"
-        )),
-    }
 }
 
 fn bench(
@@ -602,15 +625,11 @@ fn solve_with_contact(
 
 fn homogenize(
     model_path: &Path,
-    solver: SolverKind,
+    options: SolveOptions,
     json: bool,
     out: Option<&Path>,
 ) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
-    let options = SolveOptions {
-        solver,
-        ..SolveOptions::default()
-    };
     let h = fibercell::homogenize::homogenize_elastic(&model, &options)?;
     let pretty = to_pretty(&h)?;
     if let Some(out) = out {
@@ -654,6 +673,10 @@ fn homogenize(
         );
     }
     println!("asymmetry max|ABD − ABDᵀ|/max|ABD| = {:.2e}", h.asymmetry);
+    println!(
+        "solves: backward error {:.2e}, relative residual {:.2e} (largest of the seven)",
+        h.backward_error, h.relative_residual
+    );
     let m = &h.moduli;
     println!(
         "moduli: a11_11 {:.5e}  a22_22 {:.5e}  a12_12 {:.5e}  a22_11 {:.5e} N/m;  c1111 {:.5e}  c1122 {:.5e}  c2222 {:.5e} N·m",
@@ -681,20 +704,20 @@ fn homogenize(
 fn curve(
     model_path: &Path,
     (strain, steps, unload): (fibercell::cell::MacroStrain, usize, bool),
-    (solver, bonded, stabilization): (SolverKind, bool, f64),
+    (solve, bonded, stabilization): (SolveOptions, bool, f64),
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
     use fibercell::homogenize::{elasto_plastic_curve, CurveOptions};
     let model = io::load_model(model_path)?;
     let (bar, progress) = progress_bar("curve");
-    let mut incremental = IncrementalOptions {
+    let incremental = IncrementalOptions {
         progress: Some(progress),
         bonded,
         stabilization,
+        solve,
         ..IncrementalOptions::default()
     };
-    incremental.solve.solver = solver;
     let c = elasto_plastic_curve(
         &model,
         &CurveOptions {
@@ -990,18 +1013,13 @@ fn main() -> ExitCode {
         Command::Solve {
             model,
             solver,
-            ordering,
             steps,
             fixed_slip_direction,
             json,
             output,
         } => solve(
             &model,
-            SolveOptions {
-                solver,
-                ordering,
-                ..SolveOptions::default()
-            },
+            solver.options(),
             (steps, fixed_slip_direction),
             json,
             &output,
@@ -1011,7 +1029,7 @@ fn main() -> ExitCode {
             solver,
             json,
             output,
-        } => homogenize(&model, solver, json, output.as_deref()),
+        } => homogenize(&model, solver.options(), json, output.as_deref()),
         Command::Curve {
             model,
             strain,
@@ -1025,7 +1043,7 @@ fn main() -> ExitCode {
         } => curve(
             &model,
             (strain, steps, unload),
-            (solver, bonded, stabilization),
+            (solver.options(), bonded, stabilization),
             json,
             &output,
         ),

@@ -13,7 +13,7 @@ use crate::homogenize::{
 };
 use crate::model::{FrictionSpec, Model};
 use crate::solve::{
-    make_solver, ContactChange, IncrementalOptions, LowRankCorrection, SolveOptions, SolverKind,
+    ContactChange, IncrementalOptions, LowRankCorrection, SolveOptions, SolverConfig, SolverKind,
     SparseColumn,
 };
 use crate::Error;
@@ -189,7 +189,7 @@ fn updown_solver(
     rhs: &[f64],
     repeats: usize,
 ) -> Result<Option<TimedSolver>, Error> {
-    let mut solver = match make_solver(SolverKind::Cholmod, &Ordering::Auto, Vec::new()) {
+    let mut solver = match SolverConfig::new(SolverKind::Cholmod).build() {
         Ok(s) => s,
         Err(Error::Solver(fibercell_solver::SolverError::Unavailable { .. })) => return Ok(None),
         Err(e) => return Err(e),
@@ -341,7 +341,12 @@ fn bench_backend(
     repeats: usize,
     machine: &super::Machine,
 ) -> Result<BackendBench, Error> {
-    let mut solver = make_solver(kind, ordering, Vec::new())?;
+    let mut solver = SolverConfig {
+        kind,
+        ordering: ordering.clone(),
+        ..SolverConfig::default()
+    }
+    .build()?;
     let t = Instant::now();
     let info = solver.analyze(a)?;
     let analyze = t.elapsed().as_secs_f64();
@@ -466,7 +471,7 @@ fn bench_reuse(
 ) -> Result<Vec<ReuseBench>, Error> {
     let base = sys.assemble(model);
     let a0 = sys.pattern.matrix(&base.values)?;
-    let mut factor = make_solver(SolverKind::FaerCholesky, &Ordering::Auto, Vec::new())?;
+    let mut factor = SolverConfig::new(SolverKind::FaerCholesky).build()?;
     factor.analyze(a0)?;
     factor.factorize(a0)?;
     let t_solve = Instant::now();

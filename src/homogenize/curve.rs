@@ -49,6 +49,9 @@ pub struct CurvePoint {
     pub slip: usize,
     /// Dissipated energy per unit cell area so far (J/m²).
     pub dissipated: f64,
+    /// Normwise backward error ‖Ax − b‖∞/(‖A‖∞‖x‖∞ + ‖b‖∞) of the increment's last linear
+    /// solve (as `solve` reports it).
+    pub backward_error: f64,
 }
 
 /// A contact changing state.
@@ -156,6 +159,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             stick: r.stick,
             slip: r.slip,
             dissipated: r.dissipated / area,
+            backward_error: r.backward_error,
         });
     }
     // Switches: a contact's state differs from the previous increment (initial: from the first).

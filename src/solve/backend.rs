@@ -62,28 +62,61 @@ impl FromStr for SolverKind {
     }
 }
 
-/// Builds a backend. `node_blocks` are the first reduced DOFs of each node (the CG
-/// preconditioner's blocks).
-pub fn make_solver(
-    kind: SolverKind,
-    ordering: &Ordering,
-    node_blocks: Vec<usize>,
-) -> Result<Box<dyn LinearSolver>, Error> {
-    Ok(match kind {
-        SolverKind::FaerCholesky => Box::new(fibercell_faer::FaerCholesky::new(
-            fibercell_faer::CholeskyVariant::Llt,
-            ordering.clone(),
-        )),
-        SolverKind::FaerLu => Box::new(fibercell_faer::FaerLu::new()),
-        SolverKind::Cg => Box::new(fibercell_cg::ConjugateGradient::new().with_blocks(node_blocks)),
-        #[cfg(feature = "cholmod")]
-        SolverKind::Cholmod => Box::new(fibercell_cholmod::Cholmod::new(ordering.clone())),
-        #[cfg(not(feature = "cholmod"))]
-        SolverKind::Cholmod => {
-            return Err(Error::Solver(fibercell_solver::SolverError::Unavailable {
-                backend: "cholmod",
-                reason: "this build lacks the `cholmod` cargo feature (apt-get install libsuitesparse-dev libclang-dev, then build with --features cholmod)".into(),
-            }))
+/// Everything a backend is built from, in one value: the backend and its fill-reducing
+/// ordering (the CLI's `--solver` and `--ordering`), the first unknown of every node block (CG's
+/// block-Jacobi preconditioner; empty: blocks of six unknowns) and CG's stopping tolerance.
+/// Every job builds its backend through [`SolverConfig::build`]; a job gets its config from
+/// [`super::SolveOptions::solver_config`] with its discretization's node blocks.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolverConfig {
+    /// Backend.
+    pub kind: SolverKind,
+    /// Fill-reducing ordering of the direct backends (ignored by faer-lu, which orders its
+    /// columns by COLAMD, and by CG).
+    pub ordering: Ordering,
+    /// First unknown of every node block, increasing from 0 (CG's preconditioner); empty for
+    /// uniform blocks of six unknowns.
+    pub node_blocks: Vec<usize>,
+    /// CG's relative residual ‖r‖/‖b‖ at which it stops (default 1e-12 when `None`).
+    pub cg_tolerance: Option<f64>,
+}
+
+impl SolverConfig {
+    /// `kind` with the automatic ordering, uniform node blocks and the default tolerances.
+    pub fn new(kind: SolverKind) -> Self {
+        SolverConfig {
+            kind,
+            ..SolverConfig::default()
         }
-    })
+    }
+
+    /// Builds the backend.
+    pub fn build(&self) -> Result<Box<dyn LinearSolver>, Error> {
+        Ok(match self.kind {
+            SolverKind::FaerCholesky => Box::new(fibercell_faer::FaerCholesky::new(
+                fibercell_faer::CholeskyVariant::Llt,
+                self.ordering.clone(),
+            )),
+            SolverKind::FaerLu => Box::new(fibercell_faer::FaerLu::new()),
+            SolverKind::Cg => {
+                let mut cg = fibercell_cg::ConjugateGradient::new();
+                if !self.node_blocks.is_empty() {
+                    cg = cg.with_blocks(self.node_blocks.clone());
+                }
+                if let Some(tol) = self.cg_tolerance {
+                    cg = cg.with_tolerance(tol);
+                }
+                Box::new(cg)
+            }
+            #[cfg(feature = "cholmod")]
+            SolverKind::Cholmod => Box::new(fibercell_cholmod::Cholmod::new(self.ordering.clone())),
+            #[cfg(not(feature = "cholmod"))]
+            SolverKind::Cholmod => {
+                return Err(Error::Solver(fibercell_solver::SolverError::Unavailable {
+                    backend: "cholmod",
+                    reason: "this build lacks the `cholmod` cargo feature (apt-get install libsuitesparse-dev libclang-dev, then build with --features cholmod)".into(),
+                }))
+            }
+        })
+    }
 }

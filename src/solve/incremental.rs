@@ -21,7 +21,7 @@ use super::affine_reference::AffineReferences;
 use super::kept_contact_loads::KeptContactLoads;
 use super::low_rank::{Capacitance, ContactChange, LowRankCorrection, Reference, SparseColumn};
 use super::static_solve::{backward_tolerance, check_backward_error};
-use super::{check_supported_with, make_solver, IncrementTimings, SolveOptions, SolverKind};
+use super::{check_supported_with, IncrementTimings, SolveOptions, SolverConfig, SolverKind};
 use crate::assembly::{
     color_blocks, element_stiffness, Assembler, DofMap, Pattern, SharedMut, NO_SLOT,
 };
@@ -964,8 +964,10 @@ pub(crate) fn run_incremental(
         reference: None,
     };
     // Low-rank solves need a direct symmetric backend.
+    let solver_config = opts.solve.solver_config(disc.node_block_starts());
     let low_rank_possible = opts.reuse_factor
-        && make_solver(opts.solve.solver, &opts.solve.ordering, Vec::new())
+        && solver_config
+            .build()
             .is_ok_and(|s| !s.capabilities().iterative);
     // Set when the correction outgrew its columns or missed its accuracy: the next symmetric
     // factorization becomes the new reference.
@@ -1445,7 +1447,11 @@ pub(crate) fn run_incremental(
                     (&mut backends.symmetric, opts.solve.solver)
                 };
                 if slot.is_none() {
-                    let mut s = make_solver(kind, &opts.solve.ordering, disc.node_block_starts())?;
+                    let mut s = SolverConfig {
+                        kind,
+                        ..solver_config.clone()
+                    }
+                    .build()?;
                     s.analyze(a).map_err(locate)?;
                     *slot = Some(s);
                 }

@@ -924,8 +924,8 @@ impl Capacitance {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::solve::{make_solver, SolverKind};
-    use fibercell_solver::{CscMatrix, Ordering};
+    use crate::solve::{SolverConfig, SolverKind};
+    use fibercell_solver::CscMatrix;
     use nalgebra::{DMatrix, DVector};
 
     /// The Woodbury solve equals a dense solve of A₀ + U E Uᵀ (a path-graph Laplacian plus a
@@ -961,7 +961,7 @@ pub(super) mod tests {
             }
         }
         let a0 = CscMatrix::from_triplets(n, n, &triplets).expect("matrix");
-        let mut solver = make_solver(kind, &Ordering::Auto, Vec::new()).expect("solver");
+        let mut solver = SolverConfig::new(kind).build().expect("solver");
         solver.analyze(a0.as_ref()).expect("analyze");
         solver.factorize(a0.as_ref()).expect("factorize");
         (triplets, solver)

@@ -11,7 +11,7 @@ mod low_rank;
 mod reduced;
 mod static_solve;
 
-pub use backend::{make_solver, SolverKind};
+pub use backend::{SolverConfig, SolverKind};
 pub use connectivity::{check_supported, check_supported_with};
 pub use increment_timings::IncrementTimings;
 pub(crate) use incremental::{run_incremental, OnAllStick};

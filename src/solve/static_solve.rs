@@ -1,6 +1,6 @@
 //! The linear static analysis: setup → assemble → solve → check, readable in one function.
 
-use super::{check_supported, make_solver, ReducedSystem, SolverKind};
+use super::{check_supported, ReducedSystem, SolverConfig, SolverKind};
 use crate::assembly::FillMode;
 use crate::constraints::{reactions, Reaction};
 use crate::model::{Dof, Model};
@@ -22,6 +22,19 @@ pub struct SolveOptions {
     /// when zero). The relative residual ‖Ku − F‖/‖F‖ is reported but not used to reject: on
     /// slender-fiber networks its roundoff floor ε‖K‖‖u‖/‖F‖ can exceed any fixed bar.
     pub max_backward_error: f64,
+}
+
+impl SolveOptions {
+    /// The backend configuration of these options for a system whose node blocks start at
+    /// `node_blocks` (the one place every job builds its [`SolverConfig`]).
+    pub fn solver_config(&self, node_blocks: Vec<usize>) -> SolverConfig {
+        SolverConfig {
+            kind: self.solver,
+            ordering: self.ordering.clone(),
+            node_blocks,
+            cg_tolerance: None,
+        }
+    }
 }
 
 /// Wall-clock seconds of each stage.
@@ -100,7 +113,6 @@ pub(crate) fn locate(
     }
 }
 
-/// Rejects a solve whose backward error exceeds `options.max_backward_error` (1e-10 when 0).
 /// The accepted backward error of `options` (1e-10 when unset).
 pub(crate) fn backward_tolerance(options: &SolveOptions) -> f64 {
     if options.max_backward_error > 0.0 {
@@ -110,6 +122,7 @@ pub(crate) fn backward_tolerance(options: &SolveOptions) -> f64 {
     }
 }
 
+/// Rejects a solve whose backward error exceeds `options.max_backward_error` (1e-10 when 0).
 pub(crate) fn check_backward_error(
     options: &SolveOptions,
     backward_error: f64,
@@ -147,11 +160,9 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
         Vec::new()
     } else {
         let a = sys.matrix()?;
-        let mut solver = make_solver(
-            options.solver,
-            &options.ordering,
-            sys.dofs.node_block_starts(),
-        )?;
+        let mut solver = options
+            .solver_config(sys.dofs.node_block_starts())
+            .build()?;
         let t = Instant::now();
         let info = solver.analyze(a).map_err(|e| locate(e, model, &node_dof))?;
         timings.analyze = t.elapsed().as_secs_f64();
