@@ -53,6 +53,25 @@ pub struct ReferenceResults {
     pub contacts: usize,
     /// Elastic ABD per unit area (ε11, ε22, γ12, κ11, κ22, κ12).
     pub abd: [[f64; 6]; 6],
+    /// [`cell_digest`] of the cell: lets a test check that the parameters regenerate exactly
+    /// the cell where the cell itself is too large to commit.
+    pub cell_digest: String,
+}
+
+/// A fingerprint of a cell: FNV-1a (64 bits, hexadecimal) of its canonical TOML text
+/// ([`crate::io::to_toml`]), so two cells have the same digest when their files would be the
+/// same.
+pub fn cell_digest(d: &ModelDescription) -> Result<String, Error> {
+    let text = crate::io::to_toml(d).map_err(|message| Error::Output {
+        path: "the cell's TOML text".into(),
+        message,
+    })?;
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in text.as_bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    Ok(format!("{h:016x}"))
 }
 
 /// The reference results of a cell: statistics and the elastic homogenization with the
@@ -68,5 +87,6 @@ pub fn reference_results(d: &ModelDescription) -> Result<ReferenceResults, Error
         volume_fraction: s.volume_fraction.unwrap_or(0.0),
         contacts: h.contacts,
         abd: h.abd,
+        cell_digest: cell_digest(d)?,
     })
 }
