@@ -103,7 +103,8 @@ enum Command {
         #[arg(short, long, default_value = "fibercell-results")]
         output: PathBuf,
         /// Bonded contacts: closed ones never open, open ones never close; only stick and
-        /// slip evolve (for just-touching mats such as the generated non-wovens).
+        /// slip evolve. The same as `bonded = true` in the model's [contact], which the
+        /// generated non-wovens set.
         #[arg(long)]
         bonded: bool,
         /// Relative stiffness of stabilizing springs on open and sliding contacts (e.g. 1e-8),

@@ -111,7 +111,7 @@ proptest! {
             prop_assert!(ev.iter().all(|&e| e >= -1e-10 * scale), "{ev}");
         }
         let d = Vector2::new(dir.cos(), dir.sin());
-        let (ks, _) = pair.slip(Friction::Coulomb { mu: 0.3 }, &d);
+        let (ks, _) = pair.slip(Friction::Coulomb { mu: 0.3, cohesion: 0.0 }, &d);
         let m = block(&pair, &ks);
         // Rank one B^T E d nᵀ B: nonsymmetric because E d ⟂ n.
         prop_assert!((&m - m.transpose()).amax() > 1e-6 * m.amax());
@@ -162,7 +162,7 @@ proptest! {
         let (kn, _) = pair.normal();
         let (kt, _) = pair.stick(&Vector2::zeros());
         let kr = pair.rotation();
-        for friction in [Friction::Tresca { bound: 0.3 }, Friction::Coulomb { mu: 0.4 }, Friction::None] {
+        for friction in [Friction::Tresca { bound: 0.3 }, Friction::Coulomb { mu: 0.4, cohesion: 0.0 }, Friction::None] {
             for state in [ContactState::Stick, ContactState::Slip, ContactState::Open] {
                 let s = BlockState { state, direction, k_perp };
                 let coefficients = pair.block_coefficients(&s, friction, eps);

@@ -66,7 +66,7 @@ impl ContactPair {
                     pr,
                     pr,
                 ));
-                if let Friction::Coulomb { mu } = friction {
+                if let Friction::Coulomb { mu, .. } = friction {
                     d[(1, 0)] += mu * pn * s.direction[0];
                     d[(2, 0)] += mu * pn * s.direction[1];
                 }
@@ -107,7 +107,7 @@ impl ContactPair {
                 phi[0] = pn_gap;
                 let along = match friction {
                     Friction::None => 0.0,
-                    Friction::Coulomb { mu } => mu * pn_gap,
+                    Friction::Coulomb { mu, cohesion } => mu * pn_gap - cohesion,
                     Friction::Tresca { bound } => -bound,
                 };
                 let p = Vector2::new(-s.direction[1], s.direction[0]);

@@ -33,10 +33,12 @@ pub enum Friction {
     /// Frictionless: no tangential terms.
     #[default]
     None,
-    /// Coulomb: |F_t| ≤ μ N.
+    /// Coulomb with cohesion: |F_t| ≤ c + μ max(N, 0).
     Coulomb {
         /// Friction coefficient μ ≥ 0.
         mu: f64,
+        /// Cohesion c ≥ 0 (N): the bound at zero normal force.
+        cohesion: f64,
     },
     /// Tresca: |F_t| ≤ G, independent of N.
     Tresca {
@@ -212,11 +214,11 @@ impl ContactPair {
         let bd = self.bt_e(d);
         match friction {
             Friction::None => (BlockMatrix::zeros(), BlockVector::zeros()),
-            Friction::Coulomb { mu } => {
+            Friction::Coulomb { mu, cohesion } => {
                 let bn = self.bt_n();
                 (
                     bd * bn.transpose() * (mu * self.penalty_normal),
-                    bd * (mu * self.penalty_normal * self.gap),
+                    bd * (mu * self.penalty_normal * self.gap - cohesion),
                 )
             }
             Friction::Tresca { bound } => (BlockMatrix::zeros(), bd * (-bound)),

@@ -389,7 +389,7 @@ pub fn geotextile(g: &Geotextile) -> Result<ModelDescription, Error> {
             d.contact = Some(ContactSpec {
                 search: true,
                 tolerance: Some(0.1 * rmin),
-                friction: FrictionSpec::Coulomb { mu },
+                friction: FrictionSpec::Coulomb { mu, cohesion: 0.0 },
                 initial_penetration: Some(PenetrationSpec::Adjust),
                 ..Default::default()
             });

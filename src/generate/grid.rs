@@ -133,7 +133,10 @@ pub fn crossing_grid(k: usize, sub: usize, spacing: f64, radius: f64) -> ModelDe
         contact: Some(ContactSpec {
             search: true,
             tolerance: Some(0.1 * radius),
-            friction: FrictionSpec::Coulomb { mu: 0.3 },
+            friction: FrictionSpec::Coulomb {
+                mu: 0.3,
+                cohesion: 0.0,
+            },
             ..Default::default()
         }),
         contacts: Vec::new(),

@@ -244,7 +244,10 @@ pub fn knitted(k: &Knit) -> Result<ModelDescription, Error> {
         contact: Some(ContactSpec {
             search: true,
             tolerance: Some(0.1 * r),
-            friction: FrictionSpec::Coulomb { mu: k.mu },
+            friction: FrictionSpec::Coulomb {
+                mu: k.mu,
+                cohesion: 0.0,
+            },
             initial_penetration: Some(PenetrationSpec::Adjust),
             ..Default::default()
         }),

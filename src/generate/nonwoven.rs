@@ -99,6 +99,13 @@ pub struct NonWoven {
     pub poisson: f64,
     /// Coulomb friction coefficient.
     pub mu: f64,
+    /// Shear strength of the bond at a fiber crossing (Pa; default 1 MPa, a thermally bonded
+    /// polypropylene mat). Positive: the contacts are bonded (they never open, see
+    /// [`crate::model::ContactSpec::bonded`]) and resist sliding up to the cohesion
+    /// c = bond_strength · π r² plus μ N (Mohr–Coulomb). 0: loose fibers that merely touch —
+    /// a pile of sticks without tensile stiffness, whose contacts open under the first strain.
+    #[serde(default = "default_bond_strength")]
+    pub bond_strength: f64,
     /// Seed of the random generator (ChaCha8): same seed, same cell.
     pub seed: u64,
 }
@@ -120,9 +127,14 @@ impl Default for NonWoven {
             young: 1.5e9,
             poisson: 0.4,
             mu: 0.3,
+            bond_strength: default_bond_strength(),
             seed: 1,
         }
     }
+}
+
+fn default_bond_strength() -> f64 {
+    1e6
 }
 
 /// The benchmark cells of the README and `fibercell bench`, all at one areal density (5.6
@@ -185,6 +197,12 @@ impl NonWoven {
         positive("young", self.young)?;
         positive("tolerance", self.tolerance)?;
         material("non-woven", self.poisson, self.mu)?;
+        if !(self.bond_strength.is_finite() && self.bond_strength >= 0.0) {
+            return Err(invalid(format!(
+                "non-woven bond_strength = {} Pa must be finite and ≥ 0 (0: unbonded fibers)",
+                self.bond_strength
+            )));
+        }
         if !(self.tilt >= 0.0 && self.tilt < 1.5) {
             return Err(invalid(format!(
                 "non-woven tilt = {} rad must be in [0, 1.5)",
@@ -803,7 +821,11 @@ fn describe(
         contact: Some(ContactSpec {
             search: true,
             tolerance: Some(0.1 * r),
-            friction: FrictionSpec::Coulomb { mu: params.mu },
+            friction: FrictionSpec::Coulomb {
+                mu: params.mu,
+                cohesion: params.bond_strength * std::f64::consts::PI * r * r,
+            },
+            bonded: params.bond_strength > 0.0,
             ..Default::default()
         }),
         cell: Some(CellSpec {

@@ -164,7 +164,10 @@ pub fn weave(p: &Weave) -> Result<ModelDescription, Error> {
         contact: Some(ContactSpec {
             search: true,
             penalty_normal: p.penalty_normal,
-            friction: FrictionSpec::Coulomb { mu: p.mu },
+            friction: FrictionSpec::Coulomb {
+                mu: p.mu,
+                cohesion: 0.0,
+            },
             ..Default::default()
         }),
         ..Default::default()

@@ -21,6 +21,8 @@ pub struct ContactSettings {
     pub friction: Friction,
     /// Initially penetrating pairs.
     pub initial_penetration: PenetrationSpec,
+    /// Bonded contacts: closed ones never open, open ones never close.
+    pub bonded: bool,
 }
 
 /// An explicit contact pair (from `[[contacts]]`).
@@ -87,14 +89,20 @@ pub(super) fn check_settings(
     }
     let friction = match spec.friction {
         FrictionSpec::None => Friction::None,
-        FrictionSpec::Coulomb { mu } => {
+        FrictionSpec::Coulomb { mu, cohesion } => {
             if !(mu.is_finite() && mu >= 0.0) {
                 return Err(invalid(
                     item,
                     format!("friction coefficient mu = {mu} must be finite and ≥ 0"),
                 ));
             }
-            Friction::Coulomb { mu }
+            if !(cohesion.is_finite() && cohesion >= 0.0) {
+                return Err(invalid(
+                    item,
+                    format!("cohesion = {cohesion} N must be finite and ≥ 0"),
+                ));
+            }
+            Friction::Coulomb { mu, cohesion }
         }
         FrictionSpec::Tresca { bound } => {
             if !(bound.is_finite() && bound >= 0.0) {
@@ -114,6 +122,7 @@ pub(super) fn check_settings(
         penalty_rotation: spec.penalty_rotation,
         friction,
         initial_penetration: spec.initial_penetration.unwrap_or(PenetrationSpec::Adjust),
+        bonded: spec.bonded,
     })
 }
 

@@ -134,24 +134,42 @@ pub struct ContactSpec {
     /// "resolve" (pushed apart over the increments).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_penetration: Option<PenetrationSpec>,
+    /// Bonded contacts (default false): initially closed contacts never open (the normal
+    /// spring is bilateral) and open ones never close; only stick and slip evolve. A bonded or
+    /// consolidated mat, such as the generated non-wovens.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub bonded: bool,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+fn is_false(v: &bool) -> bool {
+    !*v
 }
 
 fn yes() -> bool {
     true
 }
 
-/// `friction = { law = "coulomb", mu = 0.3 }`, `{ law = "tresca", bound = 0.5 }` or
-/// `{ law = "none" }`.
+/// `friction = { law = "coulomb", mu = 0.3 }` (with an optional `cohesion = c`, N),
+/// `{ law = "tresca", bound = 0.5 }` or `{ law = "none" }`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "law", rename_all = "lowercase", deny_unknown_fields)]
 pub enum FrictionSpec {
     /// Frictionless.
     #[default]
     None,
-    /// Coulomb friction coefficient μ ≥ 0.
+    /// Coulomb friction coefficient μ ≥ 0, with cohesion c ≥ 0: |F_t| ≤ c + μ max(N, 0)
+    /// (Mohr–Coulomb; c = 0 is the thesis's law).
     Coulomb {
         /// μ.
         mu: f64,
+        /// c (N; default 0): the tangential force a contact resists at zero normal force,
+        /// e.g. a bonded crossing's bond strength.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        cohesion: f64,
     },
     /// Tresca friction bound G ≥ 0 (N).
     Tresca {

@@ -104,7 +104,24 @@ pub struct IncrementalOptions {
     /// Stop after the increment during which this instant passes (default: none); the solution
     /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
     pub deadline: Option<std::time::Instant>,
+    /// Solve Coulomb sliding with its consistent tangent K_T^sl = μ p_N Bᵀd nᵀB (4.63), a
+    /// nonsymmetric system for faer LU. Default false: each sliding contact's friction force
+    /// is a load at the bound c + μ max(N, 0) of the state iteration's last normal force N,
+    /// iterated until no bound moves by more than [`BOUND_TOLERANCE`] of itself (a fixed point
+    /// on the bounds, as for Tresca friction with the bound updated), so every system stays
+    /// symmetric for Cholesky and the low-rank corrections; at convergence both satisfy the
+    /// same Coulomb law.
+    pub consistent_coulomb_tangent: bool,
 }
+
+/// The relative change of a sliding Coulomb contact's bound c + μ max(N, 0) below which the
+/// fixed point on the bounds has converged (see
+/// [`IncrementalOptions::consistent_coulomb_tangent`]).
+pub const BOUND_TOLERANCE: f64 = 1e-8;
+
+/// State iterations of an increment after which the bounds of the Coulomb fixed point move by
+/// half the step (see the update in the state iteration).
+const BOUND_RELAXATION_AFTER: usize = 10;
 
 impl Default for IncrementalOptions {
     fn default() -> Self {
@@ -121,6 +138,7 @@ impl Default for IncrementalOptions {
             max_low_rank_columns: MAX_LOW_RANK_COLUMNS,
             max_capacitance_order: None,
             deadline: None,
+            consistent_coulomb_tangent: false,
         }
     }
 }
@@ -323,7 +341,7 @@ fn classify(
     };
     t.bound = match friction {
         Friction::None => 0.0,
-        Friction::Coulomb { mu } => mu * t.normal_force.max(0.0),
+        Friction::Coulomb { mu, cohesion } => cohesion + mu * t.normal_force.max(0.0),
         Friction::Tresca { bound } => bound,
     };
     if closed_before && friction != Friction::None && norm <= pair.penalty_tangent * length_tol {
@@ -539,6 +557,8 @@ fn refine_low_rank(
 struct ReferenceBlock {
     stiffness: BlockCoefficients,
     state: BlockState,
+    /// The contact's friction law in the reference (a Coulomb contact's bound there).
+    friction: Friction,
     anchor: Vector2<f64>,
     /// The slip its load was computed at: the reference load b₀ keeps it, so that b₀ changes
     /// with α only (see [`AffineReferences`]); a contact whose slip moved since is a change.
@@ -899,6 +919,16 @@ pub(crate) fn run_incremental(
         .contact
         .as_ref()
         .map_or(Friction::None, |c| c.friction);
+    let bonded = opts.bonded || model.contact.as_ref().is_some_and(|c| c.bonded);
+    // Coulomb sliding by a fixed point on the bounds (see
+    // IncrementalOptions::consistent_coulomb_tangent): each contact's bound c + μ max(N, 0) at
+    // the last classification, the load its sliding force is assembled with.
+    let bound_fixed_point = matches!(friction, Friction::Coulomb { mu, .. } if mu > 0.0)
+        && !opts.consistent_coulomb_tangent;
+    let mut bounds: Vec<f64> = match friction {
+        Friction::Coulomb { cohesion, .. } => vec![cohesion; set.pairs.len()],
+        _ => Vec::new(),
+    };
     let fixed: Vec<Option<Vector2<f64>>> =
         if opts.fixed_slip_direction && friction != Friction::None {
             let mut frictionless = model.clone();
@@ -1098,6 +1128,14 @@ pub(crate) fn run_incremental(
         let lap = IncrementTimings::lap;
         let mut clock = increment_start;
         for iteration in 1..=opts.max_state_iterations {
+            // The friction law contact i is assembled with.
+            let friction_of = |i: usize| -> Friction {
+                if bound_fixed_point {
+                    Friction::Tresca { bound: bounds[i] }
+                } else {
+                    friction
+                }
+            };
             let mut refactorized = false;
             // Assemble K + K_N + K_T and α F + F_N + F_T for the current states: once a
             // symmetric factorization is the reference, its values plus the blocks of the
@@ -1110,15 +1148,15 @@ pub(crate) fn run_incremental(
                         let current = block_state(&states, &directions, &perpendicular, i);
                         let r = &reference[i];
                         let stiffness =
-                            pairs[i].block_coefficients(&current, friction, stabilization)
+                            pairs[i].block_coefficients(&current, friction_of(i), stabilization)
                                 - r.stiffness;
                         let load = pairs[i].load_coefficients(
                             &current,
                             &perpendicular[i].1,
                             &slips[i],
-                            friction,
+                            friction_of(i),
                         ) - pairs[i]
-                            .load_coefficients(&r.state, &r.anchor, &r.slip, friction)
+                            .load_coefficients(&r.state, &r.anchor, &r.slip, r.friction)
                             - stiffness * prescribed_jump[i];
                         let change = ContactChange {
                             contact: i,
@@ -1142,14 +1180,15 @@ pub(crate) fn run_incremental(
                 .filter(|&i| states[i] != ContactState::Open)
                 .map(|i| &set.pairs[i].jump.nodes[..])
                 .collect();
-            let nonsymmetric = matches!(friction, Friction::Coulomb { mu } if mu > 0.0)
+            let nonsymmetric = opts.consistent_coulomb_tangent
+                && matches!(friction, Friction::Coulomb { mu, .. } if mu > 0.0)
                 && states.contains(&ContactState::Slip);
             // K_N + K_T^sl (+ the consistent tangent k⊥ across the slip direction) + K_R
             // (+ ε K_T^st) and its load, of a sliding contact.
             let sliding_block = |i: usize| -> (BlockMatrix, BlockVector) {
                 let pair = &pairs[i];
                 let (mut k, mut f) = pair.normal();
-                let (ks, fs) = pair.slip(friction, &directions[i]);
+                let (ks, fs) = pair.slip(friction_of(i), &directions[i]);
                 k += ks + pair.rotation();
                 f += fs;
                 if perpendicular[i].0 > 0.0 {
@@ -1289,8 +1328,8 @@ pub(crate) fn run_incremental(
                     let pair = &pairs[i];
                     let (anchor, slip) = (&perpendicular[i].1, &slips[i]);
                     let current = block_state(&states, &directions, &perpendicular, i);
-                    let phi = pair.load_coefficients(&current, anchor, slip, friction)
-                        - pair.load_coefficients(&base_state, anchor, slip, friction);
+                    let phi = pair.load_coefficients(&current, anchor, slip, friction_of(i))
+                        - pair.load_coefficients(&base_state, anchor, slip, friction_of(i));
                     let mut f = BlockVector::zeros();
                     for (ga, pa) in pair.jump_basis().iter().zip(phi.iter()) {
                         f += ga * *pa;
@@ -1484,10 +1523,11 @@ pub(crate) fn run_incremental(
                                     ReferenceBlock {
                                         stiffness: pairs[i].block_coefficients(
                                             &state,
-                                            friction,
+                                            friction_of(i),
                                             stabilization,
                                         ),
                                         state,
+                                        friction: friction_of(i),
                                         anchor: perpendicular[i].1,
                                         slip: slips[i],
                                     }
@@ -1527,6 +1567,15 @@ pub(crate) fn run_incremental(
             q = disc.generalized(&x, alpha);
             // Return mapping of every contact: the trials and the contacts whose state or slip
             // direction they change.
+            // A contact's state changed, or its slip direction by |Δd| · |u_t − s| above the
+            // tolerance (see SLIP_DIRECTION_TOLERANCE).
+            let switched =
+                |t: &Trial, (state, direction): (ContactState, Vector2<f64>), pt: f64| {
+                    t.state != state
+                        || (t.state == ContactState::Slip
+                            && friction != Friction::None
+                            && t.trial_norm / pt * (t.direction - direction).norm() > direction_tol)
+                };
             let classify_all = |q: &[f64]| -> (Vec<Trial>, Vec<usize>) {
                 let trials: Vec<Trial> = pairs
                     .par_iter()
@@ -1535,10 +1584,7 @@ pub(crate) fn run_incremental(
                     .map(|(i, p)| {
                         classify(
                             p,
-                            Law {
-                                friction,
-                                bonded: opts.bonded,
-                            },
+                            Law { friction, bonded },
                             &gather(q, &p.jump.nodes),
                             &slips[i],
                             (states[i], directions[i]),
@@ -1560,15 +1606,17 @@ pub(crate) fn run_incremental(
                     .collect();
                 // A slip direction has changed when |Δd| · |u_t − s| exceeds the tolerance (see
                 // SLIP_DIRECTION_TOLERANCE).
+                // ... and a sliding Coulomb contact's bound when it moved (the fixed point on
+                // the bounds).
                 let changed: Vec<usize> = (0..pairs.len())
                     .filter(|&i| {
                         let t = &trials[i];
-                        t.state != states[i]
-                            || (t.state == ContactState::Slip
-                                && friction != Friction::None
-                                && t.trial_norm / pairs[i].penalty_tangent
-                                    * (t.direction - directions[i]).norm()
-                                    > direction_tol)
+                        switched(t, (states[i], directions[i]), pairs[i].penalty_tangent)
+                            || (bound_fixed_point
+                                && t.state == ContactState::Slip
+                                && switches[i] < CHATTER_SWITCHES
+                                && (t.bound - bounds[i]).abs()
+                                    > BOUND_TOLERANCE * t.bound.max(bounds[i]))
                     })
                     .collect();
                 (trials, changed)
@@ -1611,9 +1659,34 @@ pub(crate) fn run_incremental(
                 });
             }
             for &i in &changed {
-                switches[i] += 1;
+                // A bound still moving after the relaxation set in counts as a switch too, so
+                // that a contact whose bound does not settle is held like a chattering one.
+                if iteration > BOUND_RELAXATION_AFTER
+                    || switched(
+                        &trials[i],
+                        (states[i], directions[i]),
+                        pairs[i].penalty_tangent,
+                    )
+                {
+                    switches[i] += 1;
+                }
                 states[i] = trials[i].state;
                 directions[i] = trials[i].direction;
+            }
+            if bound_fixed_point {
+                // The fixed point converges linearly with μ times the coupling of a contact's
+                // normal force to its own friction force; where that coupling is strong the
+                // plain update oscillates, so later iterations take half the step.
+                let step = if iteration > BOUND_RELAXATION_AFTER {
+                    0.5
+                } else {
+                    1.0
+                };
+                for (b, t) in bounds.iter_mut().zip(&trials) {
+                    if t.state == ContactState::Slip {
+                        *b += step * (t.bound - *b);
+                    }
+                }
             }
             for (i, t) in trials.iter().enumerate() {
                 // Newton's next iterate linearizes every sliding contact at this trial: its
