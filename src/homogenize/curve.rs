@@ -52,6 +52,14 @@ pub struct CurvePoint {
     /// Normwise backward error ‖Ax − b‖∞/(‖A‖∞‖x‖∞ + ‖b‖∞) of the increment's last linear
     /// solve (as `solve` reports it).
     pub backward_error: f64,
+    /// The increment's equilibrium residual ‖R‖/(‖K q‖ + ‖α F‖) with the contact law's own
+    /// forces (see [`crate::solve::IncrementRecord::equilibrium_residual`]).
+    pub equilibrium_residual: f64,
+    /// Contacts held in their state after chattering in this increment (their forces are the
+    /// held state's, which the residual then measures).
+    pub held: usize,
+    /// State iterations of the increment.
+    pub iterations: usize,
 }
 
 /// A contact changing state.
@@ -160,6 +168,9 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             slip: r.slip,
             dissipated: r.dissipated / area,
             backward_error: r.backward_error,
+            equilibrium_residual: r.equilibrium_residual,
+            held: r.held,
+            iterations: r.iterations,
         });
     }
     // Switches: a contact's state differs from the previous increment (initial: from the first).
