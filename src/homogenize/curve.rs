@@ -60,6 +60,16 @@ pub struct CurvePoint {
     pub held: usize,
     /// State iterations of the increment.
     pub iterations: usize,
+    /// Work of the macroscopic resultants so far per unit cell area (J/m²), by the
+    /// trapezoidal rule over the increments.
+    pub external_work: f64,
+    /// Elastic energy stored in the fibers and contact springs per unit area (J/m²).
+    pub stored_energy: f64,
+    /// Energy of the stabilizing springs per unit area (J/m²; 0 without stabilization).
+    pub stabilization_energy: f64,
+    /// |W_ext − E_el − E_stab − D| / W_ext: the energy balance (see
+    /// [`crate::solve::EnergyBalance`]).
+    pub energy_error: f64,
 }
 
 /// A contact changing state.
@@ -171,6 +181,10 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             equilibrium_residual: r.equilibrium_residual,
             held: r.held,
             iterations: r.iterations,
+            external_work: r.energy.external_work / area,
+            stored_energy: r.energy.stored / area,
+            stabilization_energy: r.energy.stabilization / area,
+            energy_error: r.energy.relative_error,
         });
     }
     // Switches: a contact's state differs from the previous increment (initial: from the first).

@@ -199,6 +199,27 @@ pub struct IncrementRecord {
     /// direction, not the linearization the last system was assembled with), K q the
     /// elements' forces. About the solves' accuracy and the bounds' fixed-point tolerance.
     pub equilibrium_residual: f64,
+    /// The energy of the increment's state (J): the work of the external forces so far, the
+    /// elastic energy stored in the elements and contact springs, the energy of the
+    /// stabilizing springs, and [`IncrementRecord::dissipated`].
+    pub energy: EnergyBalance,
+}
+
+/// The energy balance of a stick/slip path: W_ext = E_el + E_stab + D up to the quadrature
+/// of W_ext (the trapezoidal rule on each increment, exact where the response is linear in it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct EnergyBalance {
+    /// Work of the external forces (loads and reactions, the macroscopic resultants of a cell)
+    /// so far, by the trapezoidal rule over the increments: Σ ½ (f_{n−1} + f_n)·(q_n − q_{n−1}),
+    /// f the generalized forces K q + f_c (at equilibrium the external ones).
+    pub external_work: f64,
+    /// Elastic energy: ½ qᵀ K q of the elements, and per closed contact ½ N²/p_N + ½ |F_t|²/p_T
+    /// + ½ qᵀ K_R q of its springs.
+    pub stored: f64,
+    /// Energy of the stabilizing springs (0 without stabilization).
+    pub stabilization: f64,
+    /// |W_ext − E_el − E_stab − D| / W_ext (0 when no work was done).
+    pub relative_error: f64,
 }
 
 /// One contact at the end of an increment.
@@ -1104,6 +1125,12 @@ pub(crate) fn run_incremental(
         )));
     }
     let mut dissipated = 0.0;
+    // W_ext so far, and the generalized forces and displacements of the last increment.
+    let mut external_work = 0.0;
+    let mut previous = (
+        vec![0.0; 6 * disc.n_gnodes()],
+        vec![0.0; 6 * disc.n_gnodes()],
+    );
     // CG iterations preconditioned by the previous factorization allowed per solve (0: none).
     let mut low_rank_cost = LowRankCost {
         factorize: None,
@@ -1771,6 +1798,8 @@ pub(crate) fn run_incremental(
         let mut records = Vec::with_capacity(pairs.len());
         let mut forces = elastic.internal(model, &q);
         let element_forces_norm = free_norm(disc, &forces, None);
+        let mut stored: f64 = 0.5 * q.iter().zip(&forces).map(|(a, b)| a * b).sum::<f64>();
+        let mut stabilization_energy = 0.0;
         // Per contact, in parallel: its new slip, dissipation, generalized forces and record;
         // then applied in contact order (the same sums as one pass).
         let committed: Vec<_> = pairs
@@ -1792,11 +1821,19 @@ pub(crate) fn run_incremental(
                 let force = pair.normal * t.normal_force + ft;
                 let mut fq = pair.jump.b.transpose() * force;
                 let q_block = gather(&q, &pair.jump.nodes);
+                // The springs' elastic energy: normal, tangential, rotational; the stabilizer's.
+                let mut energy = (0.0, 0.0);
                 if t.state != ContactState::Open {
-                    fq += pair.jump.r.transpose() * pair.rotation_moment(&q_block);
+                    let rotation = pair.jump.r.transpose() * pair.rotation_moment(&q_block);
+                    energy.0 = 0.5 * t.normal_force * t.normal_force / pair.penalty_normal
+                        + 0.5 * t.tangential.norm_squared() / pair.penalty_tangent
+                        + 0.5 * q_block.dot(&rotation);
+                    fq += rotation;
                 }
                 if stabilization > 0.0 && t.state != ContactState::Stick {
-                    fq += stabilizer_force(pair, t.state, &q_block) * stabilization;
+                    let f = stabilizer_force(pair, t.state, &q_block) * stabilization;
+                    energy.1 = 0.5 * q_block.dot(&f);
+                    fq += f;
                 }
                 let record = ContactRecord {
                     state: t.state,
@@ -1810,14 +1847,16 @@ pub(crate) fn run_incremental(
                         [g[0], g[1], g[2]]
                     },
                 };
-                (new_slip, dissipation, fq, record)
+                (new_slip, dissipation, fq, record, energy)
             })
             .collect();
-        for (i, (new_slip, dissipation, fq, record)) in committed.into_iter().enumerate() {
+        for (i, (new_slip, dissipation, fq, record, energy)) in committed.into_iter().enumerate() {
             if let Some(new) = new_slip {
                 slips[i] = new;
             }
             dissipated += dissipation;
+            stored += energy.0;
+            stabilization_energy += energy.1;
             for (k, &n) in pairs[i].jump.nodes.iter().enumerate() {
                 for d in 0..6 {
                     forces[6 * n + d] += fq[6 * k + d];
@@ -1825,6 +1864,26 @@ pub(crate) fn run_incremental(
             }
             records.push(record);
         }
+        // W_ext by the trapezoidal rule over this increment.
+        external_work += 0.5
+            * forces
+                .iter()
+                .zip(&previous.0)
+                .zip(q.iter().zip(&previous.1))
+                .map(|((f, f0), (x, x0))| (f + f0) * (x - x0))
+                .sum::<f64>();
+        let energy = EnergyBalance {
+            external_work,
+            stored,
+            stabilization: stabilization_energy,
+            relative_error: if external_work.abs() > 0.0 {
+                (external_work - stored - stabilization_energy - dissipated).abs()
+                    / external_work.abs()
+            } else {
+                0.0
+            },
+        };
+        previous = (forces.clone(), q.clone());
         let load_norm = alpha * applied_free.iter().map(|v| v * v).sum::<f64>().sqrt();
         let equilibrium_residual = free_norm(disc, &forces, Some((&applied_free, alpha)))
             / (element_forces_norm + load_norm).max(f64::MIN_POSITIVE);
@@ -1874,6 +1933,7 @@ pub(crate) fn run_incremental(
             },
             backward_error: bwd,
             equilibrium_residual,
+            energy,
         });
         out.contact_results.push(records);
         out.displacements.push(disc.physical(&q));
