@@ -149,7 +149,7 @@ impl dyn LinearSolver {
         Ok(())
     }
 
-    /// [`Self::check_matrix`] plus a symmetric pattern: what every symmetric backend checks in
+    /// `check_matrix` plus a symmetric pattern: what every symmetric backend checks in
     /// `analyze` before it orders (a single triangle would otherwise be ordered and factorized
     /// as if it were the whole matrix).
     pub fn check_symmetric_matrix(a: CscRef<'_>) -> Result<(), SolverError> {
