@@ -169,6 +169,21 @@ enum Command {
         #[arg(long)]
         readme: Option<PathBuf>,
     },
+    /// Solve A x = b for a matrix in Matrix Market form (coordinate real/integer, general or
+    /// symmetric) with any backend, and report the phases' times, nnz(L), flops and the
+    /// residual: the solver layer on matrices from anywhere.
+    SolveMatrix {
+        /// Matrix Market file of A.
+        matrix: PathBuf,
+        /// Matrix Market `array` file of b (default: b = A·1, whose solution is all ones).
+        #[arg(long)]
+        rhs: Option<PathBuf>,
+        #[command(flatten)]
+        solver: SolverArgs,
+        /// Print one JSON document.
+        #[arg(long)]
+        json: bool,
+    },
     /// Write the reduced stiffness matrix in Matrix Market form (symmetric, lower triangle).
     ExportMatrix {
         /// Model file.
@@ -987,6 +1002,78 @@ fn convert(input: &Path, output: &Path) -> Result<(), Error> {
     Ok(())
 }
 
+fn read_text(path: &Path) -> Result<String, Error> {
+    std::fs::read_to_string(path).map_err(|e| {
+        Error::Input(io::InputError::Read {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
+    })
+}
+
+fn solve_matrix(
+    matrix: &Path,
+    rhs: Option<&Path>,
+    solver: &SolverArgs,
+    json: bool,
+) -> Result<(), Error> {
+    let in_file = |path: &Path, e: fibercell::solver::SolverError| {
+        Error::Input(io::InputError::Read {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
+    };
+    let a = fibercell::solver::read_matrix_market(&read_text(matrix)?)
+        .map_err(|e| in_file(matrix, e))?;
+    let b = match rhs {
+        Some(path) => {
+            let (n, k, values) = fibercell::solver::read_matrix_market_dense(&read_text(path)?)
+                .map_err(|e| in_file(path, e))?;
+            if k != 1 || n != a.as_ref().nrows() {
+                return Err(Error::InvalidOption(format!(
+                    "{}: b is {n} × {k}, the matrix needs one column of {}",
+                    path.display(),
+                    a.as_ref().nrows()
+                )));
+            }
+            Some(values)
+        }
+        None => None,
+    };
+    let config = solver.options().solver_config(Vec::new());
+    let (_, r) = fibercell::solve::solve_matrix(a.as_ref(), b.as_deref(), &config)?;
+    if json {
+        println!("{}", to_pretty(&r)?);
+        return Ok(());
+    }
+    println!(
+        "{}: n {}, nnz(A) {}, backend {} (ordering {})",
+        matrix.display(),
+        r.n,
+        r.nnz,
+        r.backend,
+        r.ordering
+    );
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3e}"));
+    println!(
+        "nnz(L) {}, flops {}, iterations {}",
+        r.nnz_factor.map_or("-".to_string(), |v| v.to_string()),
+        opt(r.flops),
+        r.iterations.map_or("-".to_string(), |v| v.to_string())
+    );
+    println!(
+        "time (s): analyze {:.4}  factorize {:.4}  solve {:.4}",
+        r.analyze_seconds, r.factorize_seconds, r.solve_seconds
+    );
+    println!(
+        "relative residual {:.2e}, backward error {:.2e}, max |x − 1| {}",
+        r.relative_residual,
+        r.backward_error,
+        opt(r.error_against_ones)
+    );
+    Ok(())
+}
+
 fn export_matrix(model_path: &Path, out: &Path) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
     let sys = fibercell::solve::ReducedSystem::assemble(&model, Default::default())?;
@@ -1052,6 +1139,12 @@ fn main() -> ExitCode {
         Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),
         Command::Convert { input, output } => convert(&input, &output),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
+        Command::SolveMatrix {
+            matrix,
+            rhs,
+            solver,
+            json,
+        } => solve_matrix(&matrix, rhs.as_deref(), &solver, json),
         Command::Bench {
             cells,
             json,

@@ -8,6 +8,7 @@ mod increment_timings;
 mod incremental;
 mod kept_contact_loads;
 mod low_rank;
+mod matrix_solve;
 mod reduced;
 mod static_solve;
 
@@ -20,6 +21,7 @@ pub use incremental::{
     IncrementalSolution, Progress, BOUND_TOLERANCE, MAX_LOW_RANK_COLUMNS,
 };
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
+pub use matrix_solve::{solve_matrix, MatrixSolveReport};
 pub use reduced::ReducedSystem;
 pub(crate) use static_solve::{check_backward_error, locate};
 pub use static_solve::{solve_static, SolveOptions, SolveSummary, StaticSolution, Timings};

@@ -21,6 +21,7 @@ mod error;
 mod factor_pcg;
 mod forward;
 mod lower;
+mod matrix_market;
 mod ordering;
 mod residual;
 mod solver;
@@ -30,6 +31,7 @@ pub use error::{SolverError, StopReason};
 pub use factor_pcg::{pcg_with_factor, FactorPcg};
 pub use forward::{ForwardBlock, ForwardColumns};
 pub use lower::LowerTriangle;
+pub use matrix_market::{read_matrix_market, read_matrix_market_dense};
 pub use ordering::{compute_ordering, Ordering, Permutation};
 pub use residual::{
     backward_error, backward_from_product, norm_inf, norm_inf_symmetric_par, relative_from_product,
