@@ -170,6 +170,43 @@ fn cell_rhs(vals: &PeriodicValues, n: usize, extra: usize) -> Vec<f64> {
     rhs
 }
 
+/// The linear systems a job solves, as matrices for other tools: the matrix, its right-hand
+/// sides (column after column) and, per row, the node id and DOF of the unknown.
+#[derive(Clone, Debug)]
+pub struct LinearSystem {
+    /// The matrix, both triangles stored.
+    pub matrix: fibercell_solver::CscMatrix,
+    /// The right-hand sides, `columns` of length n, column after column.
+    pub rhs: Vec<f64>,
+    /// Number of right-hand sides.
+    pub columns: usize,
+    /// Per row: node id and DOF of its unknown.
+    pub dofs: Vec<(u64, crate::model::Dof)>,
+}
+
+/// The six elastic cell problems of `model` (which needs a `[cell]`): K_ff after periodic
+/// elimination and anchoring, with every closed contact in stick (thesis 5.5), and the right-
+/// hand sides −K_fE e_k for e_k = ε11, ε22, γ12, κ11, κ22, κ12 — what
+/// [`homogenize_elastic`] factorizes and solves.
+pub fn cell_problem(model: &Model) -> Result<LinearSystem, Error> {
+    let sys = PeriodicSystem::new(model)?;
+    let vals = sys.assemble(model);
+    let n = sys.n_free();
+    let matrix = sys.pattern.matrix(&vals.values)?.to_owned();
+    let dofs = (0..n)
+        .map(|k| {
+            let (node, dof) = sys.node_dof(k);
+            (model.nodes[node].id, dof)
+        })
+        .collect();
+    Ok(LinearSystem {
+        matrix,
+        rhs: cell_rhs(&vals, n, 0),
+        columns: 6,
+        dofs,
+    })
+}
+
 /// The all-stick ABD of `model` alone: the six cell problems of [`homogenize_elastic`]
 /// without the pressure problem Θ, the moduli and the expanded solutions (what
 /// [`super::elasto_plastic_curve`] splits its resultants with).

@@ -13,7 +13,8 @@ pub(crate) mod system;
 
 pub use curve::{elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEvent};
 pub use elastic::{
-    elastic_abd, homogenize_elastic, HomogenizeTimings, Homogenized, PressureResponse,
+    cell_problem, elastic_abd, homogenize_elastic, HomogenizeTimings, Homogenized, LinearSystem,
+    PressureResponse,
 };
 pub use orthotropic::{Orthotropic, ThesisModuli};
 pub use pressure::{default_pixel, pressure_load, PressureLoad};

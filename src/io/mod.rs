@@ -21,7 +21,7 @@ pub use curve_files::{
     RESULTANT_UNITS,
 };
 pub use error::InputError;
-pub use matrix_market::write_matrix_market;
+pub use matrix_market::{write_matrix_market, write_matrix_market_dense};
 pub use native::{parse_json, parse_toml, parse_toml_as, to_json, to_toml};
 pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};
 pub use results::{
