@@ -34,6 +34,9 @@ pub enum Error {
         /// The pivot relative to its diagonal entry.
         pivot: f64,
     },
+    /// A static solve was asked of a periodic cell, whose problems are the cell problems.
+    #[error("the model is a periodic cell without supports: a static solve has nothing to hold it; run `fibercell homogenize` for its effective stiffness (ABD) or `fibercell curve` for its friction curve")]
+    CellWithoutSupports,
     /// The sparse solver failed.
     #[error("solver: {0}")]
     Solver(#[from] SolverError),

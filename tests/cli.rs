@@ -649,3 +649,16 @@ fn export_matrix_of_a_cell_writes_its_cell_problems() {
         .expect("the cell matrix is not singular");
     assert!(r.backward_error <= 1e-14, "{}", r.backward_error);
 }
+
+/// `solve` on a periodic cell points to the commands that solve cells instead of calling its
+/// fibers "held by nothing".
+#[test]
+fn solve_on_a_cell_points_to_homogenize() {
+    for cell in ["fixtures/woven_plain.toml", "fixtures/ok_cell_grid.toml"] {
+        let out = tmpdir("solve-cell");
+        fails_saying(
+            &["solve", cell, "-o", out.to_str().expect("path")],
+            "run `fibercell homogenize`",
+        );
+    }
+}

@@ -15,6 +15,9 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
 /// Fails with [`Error::Unsupported`] naming the fibers of the first group (in fiber order)
 /// that no support touches.
 pub fn check_supported(model: &Model) -> Result<(), Error> {
+    if model.cell.is_some() && model.supports.is_empty() {
+        return Err(Error::CellWithoutSupports);
+    }
     check_supported_with(model, &[])
 }
 

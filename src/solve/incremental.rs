@@ -727,6 +727,9 @@ pub fn solve_incremental(
     model: &Model,
     opts: &IncrementalOptions,
 ) -> Result<IncrementalSolution, Error> {
+    if model.cell.is_some() && model.supports.is_empty() {
+        return Err(Error::CellWithoutSupports);
+    }
     let set = ContactSet::build(model)?;
     run_incremental(model, &Discretization::supported(model), set, opts, None)
 }
