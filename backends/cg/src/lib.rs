@@ -6,8 +6,8 @@ mod block_jacobi;
 
 pub use block_jacobi::BlockJacobi;
 use fibercell_solver::{
-    AnalyzeInfo, Capabilities, CscMatrix, CscRef, LinearSolver, PatternFingerprint, SolveInfo,
-    SolverError, StopReason,
+    vector_norm_inf, AnalyzeInfo, Capabilities, CscMatrix, CscRef, LinearSolver,
+    PatternFingerprint, SolveInfo, SolverError, StopReason,
 };
 
 /// Preconditioned conjugate gradients.
@@ -67,7 +67,8 @@ impl ConjugateGradient {
             return true;
         }
         self.backward_tolerance > 0.0
-            && inf_norm(r) <= self.backward_tolerance * (norm_a * inf_norm(x) + bnorm_inf)
+            && vector_norm_inf(r)
+                <= self.backward_tolerance * (norm_a * vector_norm_inf(x) + bnorm_inf)
     }
 
     /// Iteration limit (default 10·n).
@@ -118,7 +119,7 @@ impl ConjugateGradient {
         bnorm: f64,
         budget: usize,
     ) -> (usize, StopReason) {
-        let scales = (norm_a, inf_norm(b));
+        let scales = (norm_a, vector_norm_inf(b));
         let n = b.len();
         let mut r = vec![0.0; n];
         a.mul_vec_symmetric_par(x, &mut r);
@@ -192,7 +193,7 @@ impl ConjugateGradient {
                 .zip(b.iter())
                 .for_each(|(ri, bi)| *ri = bi - *ri);
             let true_rel = norm(&r) / bnorm;
-            let met = self.converged(&r, &x, bnorm, (norm_a, inf_norm(b)));
+            let met = self.converged(&r, &x, bnorm, (norm_a, vector_norm_inf(b)));
             let gained = true_rel < 0.5 * best;
             if true_rel < best {
                 best = true_rel;
@@ -213,10 +214,6 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
-}
-
-fn inf_norm(a: &[f64]) -> f64 {
-    a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
 }
 
 impl LinearSolver for ConjugateGradient {

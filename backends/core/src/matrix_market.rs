@@ -85,6 +85,20 @@ fn number<T: std::str::FromStr>(
     })
 }
 
+/// The size line after the header: its line number and its `N` counts, named by `what`.
+fn size_line<'a, const N: usize>(
+    data: &mut impl Iterator<Item = (usize, &'a str)>,
+    what: [&str; N],
+) -> Result<(usize, [usize; N]), SolverError> {
+    let (line, size) = data.next().ok_or_else(|| bad(2, "missing the size line"))?;
+    let mut words = size.split_whitespace();
+    let mut counts = [0usize; N];
+    for (c, w) in counts.iter_mut().zip(what) {
+        *c = number(line, words.next(), w)?;
+    }
+    Ok((line, counts))
+}
+
 fn finite(line: usize, v: f64) -> Result<f64, SolverError> {
     if v.is_finite() {
         Ok(v)
@@ -106,11 +120,8 @@ pub fn read_matrix_market(text: &str) -> Result<CscMatrix, SolverError> {
         return Err(bad(1, "a sparse matrix needs the coordinate layout"));
     }
     let mut data = data.into_iter();
-    let (line, size) = data.next().ok_or_else(|| bad(2, "missing the size line"))?;
-    let mut words = size.split_whitespace();
-    let nrows: usize = number(line, words.next(), "row count")?;
-    let ncols: usize = number(line, words.next(), "column count")?;
-    let nnz: usize = number(line, words.next(), "entry count")?;
+    let (line, [nrows, ncols, nnz]) =
+        size_line(&mut data, ["row count", "column count", "entry count"])?;
     if symmetry != Symmetry::General && nrows != ncols {
         return Err(bad(line, "a symmetric matrix must be square"));
     }
@@ -118,11 +129,12 @@ pub fn read_matrix_market(text: &str) -> Result<CscMatrix, SolverError> {
     if nnz > text.len() {
         return Err(bad(line, format!("{nnz} entries cannot fit in the file")));
     }
+    let last = text.lines().count();
     let mut triplets = Vec::with_capacity(2 * nnz);
     for _ in 0..nnz {
         let (line, entry) = data
             .next()
-            .ok_or_else(|| bad(0, format!("the file ends before its {nnz} entries")))?;
+            .ok_or_else(|| bad(last, format!("the file ends before its {nnz} entries")))?;
         let mut words = entry.split_whitespace();
         let i: usize = number(line, words.next(), "row index")?;
         let j: usize = number(line, words.next(), "column index")?;
@@ -169,10 +181,7 @@ pub fn read_matrix_market_dense(text: &str) -> Result<(usize, usize, Vec<f64>), 
         return Err(bad(1, "a dense block needs \"array real general\""));
     }
     let mut data = data.into_iter();
-    let (line, size) = data.next().ok_or_else(|| bad(2, "missing the size line"))?;
-    let mut words = size.split_whitespace();
-    let nrows: usize = number(line, words.next(), "row count")?;
-    let ncols: usize = number(line, words.next(), "column count")?;
+    let (line, [nrows, ncols]) = size_line(&mut data, ["row count", "column count"])?;
     let count = nrows
         .checked_mul(ncols)
         .filter(|&c| c <= text.len())
@@ -190,7 +199,7 @@ pub fn read_matrix_market_dense(text: &str) -> Result<(usize, usize, Vec<f64>), 
     }
     if values.len() != count {
         return Err(bad(
-            0,
+            text.lines().count(),
             format!("{} values for a {nrows} × {ncols} array", values.len()),
         ));
     }
