@@ -770,10 +770,12 @@ impl LowRankCorrection {
         let known = projection.len();
         projection.resize(self.columns.len(), 0.0);
         if let ColumnMode::Forward(store) = &self.mode {
-            // The blocks' products on the threads, summed per column after.
-            let products: Vec<(&[usize], Vec<f64>)> = store
+            // The blocks' products on the threads, summed per column after in the order of
+            // the blocks' keys (the map's own order changes from run to run, and with it the
+            // last bits of the sums).
+            let mut products: Vec<(usize, &[usize], Vec<f64>)> = store
                 .par_iter()
-                .filter_map(|(_, blk)| {
+                .filter_map(|(&key, blk)| {
                     let new = blk.columns.partition_point(|&c| c < known);
                     debug_assert!(blk.columns[new..].iter().all(|&c| c >= known));
                     if new == blk.columns.len() {
@@ -790,10 +792,11 @@ impl LowRankCorrection {
                         1.0,
                         blk.par(),
                     );
-                    Some((&blk.columns[new..], products))
+                    Some((key, &blk.columns[new..], products))
                 })
                 .collect();
-            for (columns, products) in products {
+            products.sort_unstable_by_key(|p| p.0);
+            for (_, columns, products) in products {
                 for (&c, p) in columns.iter().zip(&products) {
                     projection[c] += p;
                 }
