@@ -1,0 +1,315 @@
+//! Assembly of one state iteration's system K + K_N + K_T, α F + F_N + F_T for the current
+//! contact states: once a symmetric factorization is the reference, as its matrix plus the
+//! blocks of the contacts changed since (G ΔD Gᵀ, a low-rank change); before that, element and
+//! contact blocks anew.
+
+use super::contact_states::ContactStates;
+use super::increment::Increment;
+use super::setup::Setup;
+use super::stabilizer::stabilizer;
+use super::StickSlip;
+use crate::assembly::{SharedMut, NO_SLOT};
+use crate::contact::{BlockMatrix, BlockState, BlockVector, ContactState};
+use crate::solve::check_supported_with;
+use crate::solve::kept_contact_loads::KeptContactLoads;
+use crate::solve::low_rank::ContactChange;
+use crate::Error;
+use nalgebra::Vector2;
+use rayon::prelude::*;
+
+/// The system of one state iteration.
+pub(super) struct System {
+    /// The contacts whose block or load differs from the reference factorization's (None: no
+    /// reference yet, `values` assembled anew).
+    pub changes: Option<Vec<ContactChange>>,
+    /// The matrix values do not include `changes` yet (see `MatrixValues::catch_up`).
+    pub values_behind: bool,
+    /// The load.
+    pub rhs: Vec<f64>,
+    /// A Coulomb-sliding contact with the consistent tangent makes it nonsymmetric.
+    pub nonsymmetric: bool,
+}
+
+impl StickSlip<'_, '_> {
+    /// Assembles the system of the current contact states.
+    pub(super) fn assemble(&mut self, inc: &mut Increment) -> Result<System, Error> {
+        let StickSlip {
+            setup,
+            contacts,
+            factors,
+            matrix,
+            kept_loads,
+            ..
+        } = self;
+        let changes = factors
+            .reference
+            .as_deref()
+            .map(|reference| contact_changes(setup, contacts, reference, inc));
+        if changes.is_none() {
+            matrix.changed_since_reference = None;
+            matrix.values.copy_from_slice(&setup.k_elastic);
+        }
+        let mut rhs: Vec<f64> = setup.rhs_full.iter().map(|v| inc.alpha * v).collect();
+        let scatter = Scatter {
+            setup,
+            contacts,
+            alpha: inc.alpha,
+        };
+        if changes.is_none() {
+            // The contact blocks and loads for the current states.
+            scatter.by_colors(
+                &|i| Some(contacts.states[i]),
+                &mut rhs,
+                Some(&mut matrix.values),
+            );
+        } else {
+            scatter.loads(inc, kept_loads, &mut rhs);
+        }
+        if setup.disc.is_identity() {
+            let closed: Vec<&[usize]> = (0..setup.pairs.len())
+                .filter(|&i| contacts.states[i] != ContactState::Open)
+                .map(|i| &setup.set.pairs[i].jump.nodes[..])
+                .collect();
+            check_supported_with(setup.model, &closed)?;
+        }
+        let nonsymmetric = setup.opts.consistent_coulomb_tangent
+            && matches!(setup.friction(), crate::contact::Friction::Coulomb { mu, .. } if mu > 0.0)
+            && contacts.states.contains(&ContactState::Slip);
+        inc.lap(|t| &mut t.assemble);
+        Ok(System {
+            // With a reference, the values follow the changes only where the matrix is read
+            // (a residual check or a factorization).
+            values_behind: changes.is_some(),
+            changes,
+            rhs,
+            nonsymmetric,
+        })
+    }
+}
+
+/// The contacts whose block coefficients or load differ from the reference's.
+fn contact_changes(
+    setup: &Setup<'_>,
+    contacts: &ContactStates,
+    reference: &[super::factors::ReferenceBlock],
+    inc: &Increment,
+) -> Vec<ContactChange> {
+    let pairs = &setup.pairs;
+    (0..pairs.len())
+        .into_par_iter()
+        .with_min_len(256)
+        .filter_map(|i| {
+            let current = contacts.block(i);
+            let r = &reference[i];
+            let friction = contacts.friction_of(i);
+            let stiffness =
+                pairs[i].block_coefficients(&current, friction, setup.stabilization) - r.stiffness;
+            let load = pairs[i].load_coefficients(
+                &current,
+                &contacts.perpendicular[i].1,
+                &contacts.slips[i],
+                friction,
+            ) - pairs[i].load_coefficients(&r.state, &r.anchor, &r.slip, r.friction)
+                - stiffness * inc.prescribed_jump[i];
+            let change = ContactChange {
+                contact: i,
+                stiffness,
+                load,
+            };
+            change.is_change().then_some(change)
+        })
+        .collect()
+}
+
+/// Scatters contact blocks and loads into a system.
+struct Scatter<'s, 'a> {
+    setup: &'s Setup<'a>,
+    contacts: &'s ContactStates,
+    alpha: f64,
+}
+
+impl Scatter<'_, '_> {
+    /// K_N + K_T^sl (+ the consistent tangent k⊥ across the slip direction) + K_R (+ ε K_T^st)
+    /// and its load, of sliding contact i.
+    fn sliding_block(&self, i: usize) -> (BlockMatrix, BlockVector) {
+        let (pair, c) = (&self.setup.pairs[i], self.contacts);
+        let (mut k, mut f) = pair.normal();
+        let (ks, fs) = pair.slip(c.friction_of(i), &c.directions[i]);
+        k += ks + pair.rotation();
+        f += fs;
+        if c.perpendicular[i].0 > 0.0 {
+            let (kp, fp) = pair.slip_perpendicular(
+                &c.directions[i],
+                c.perpendicular[i].0,
+                &c.perpendicular[i].1,
+            );
+            k += kp;
+            f += fp;
+        }
+        if self.setup.stabilization > 0.0 {
+            k += stabilizer(pair, ContactState::Slip) * self.setup.stabilization;
+        }
+        (k, f)
+    }
+
+    /// Contact i's load in `state`, times `sign`, into `rhs`, and with `values` its block into
+    /// the matrix: the caller keeps concurrent calls on distinct nodes.
+    fn contact_into(
+        &self,
+        i: usize,
+        state: ContactState,
+        sign: f64,
+        rhs: &SharedMut<f64>,
+        values: Option<&SharedMut<f64>>,
+    ) {
+        let (setup, alpha) = (self.setup, self.alpha);
+        let disc = setup.disc;
+        let pair = &setup.pairs[i];
+        let m = pair.size();
+        let slots = setup.pattern.extra_slots(i);
+        let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
+        let scatter = |k: &dyn Fn(usize, usize) -> f64, f: &BlockVector| {
+            for r in 0..m {
+                let Some(ir) = disc.reduced(gdof(r)) else {
+                    continue;
+                };
+                // SAFETY: row r is a free DOF of a node no concurrent call holds, and so are
+                // the slots of row r.
+                let rhs_r = unsafe { rhs.get(ir) };
+                *rhs_r += sign * f[r];
+                if let Some(values) = values {
+                    for c in 0..m {
+                        let s = slots[r * m + c];
+                        if s != NO_SLOT {
+                            // SAFETY: as above.
+                            unsafe { *values.get(s as usize) += k(r, c) };
+                        }
+                    }
+                }
+                for &c in &setup.prescribed[i] {
+                    *rhs_r -= sign * k(r, c) * alpha * disc.prescribed_value(gdof(c));
+                }
+            }
+        };
+        let stabilization = setup.stabilization;
+        match state {
+            // Stuck contacts, the most, entry by entry: K_N + K_T^st + K_R.
+            ContactState::Stick => scatter(
+                &pair.closed_stiffness(true),
+                &pair.stick_load(&self.contacts.slips[i]),
+            ),
+            // ε (K_N + K_T^st + K_R), the open contact's stabilizer.
+            ContactState::Open if stabilization > 0.0 => {
+                let k = pair.closed_stiffness(true);
+                scatter(&|r, c| stabilization * k(r, c), &BlockVector::zeros())
+            }
+            ContactState::Open => {}
+            ContactState::Slip => {
+                let (k, f) = self.sliding_block(i);
+                scatter(&|r, c| k[(r, c)], &f)
+            }
+        }
+    }
+
+    /// Every contact in the state `state` gives it (None: left out), color by color in
+    /// parallel (sums independent of the number of threads).
+    fn by_colors(
+        &self,
+        state: &(dyn Fn(usize) -> Option<ContactState> + Sync),
+        rhs: &mut [f64],
+        values: Option<&mut [f64]>,
+    ) {
+        let shared_rhs = SharedMut::new(rhs);
+        let shared_values = values.map(SharedMut::new);
+        for color in &self.setup.contact_colors {
+            color.par_iter().with_min_len(16).for_each(|&i| {
+                if let Some(state) = state(i) {
+                    self.contact_into(i, state, 1.0, &shared_rhs, shared_values.as_ref())
+                }
+            });
+        }
+    }
+
+    /// Only the load: once per increment every contact stuck, or open if it is open now (α
+    /// and the slips are fixed within it), then the contacts in another state swapped in.
+    fn loads(&self, inc: &mut Increment, kept: &mut Option<KeptContactLoads>, rhs: &mut [f64]) {
+        let (setup, contacts) = (self.setup, self.contacts);
+        let pairs = &setup.pairs;
+        let (base_states, base) = inc
+            .base_load
+            .get_or_insert_with(|| self.base_load(kept, rhs));
+        rhs.copy_from_slice(base);
+        let shared_rhs = SharedMut::new(rhs);
+        for i in (0..pairs.len()).filter(|&i| contacts.states[i] != base_states[i]) {
+            if !setup.prescribed[i].is_empty() {
+                self.contact_into(i, base_states[i], -1.0, &shared_rhs, None);
+                self.contact_into(i, contacts.states[i], 1.0, &shared_rhs, None);
+                continue;
+            }
+            let base_state = BlockState {
+                state: base_states[i],
+                direction: Vector2::zeros(),
+                k_perp: 0.0,
+            };
+            // No prescribed DOFs: the load alone, G (φ − φ_base) (see
+            // ContactPair::load_coefficients), without the block.
+            let pair = &pairs[i];
+            let (anchor, slip) = (&contacts.perpendicular[i].1, &contacts.slips[i]);
+            let friction = contacts.friction_of(i);
+            let phi = pair.load_coefficients(&contacts.block(i), anchor, slip, friction)
+                - pair.load_coefficients(&base_state, anchor, slip, friction);
+            let mut f = BlockVector::zeros();
+            for (ga, pa) in pair.jump_basis().iter().zip(phi.iter()) {
+                f += ga * *pa;
+            }
+            for (r, ir) in super::factor_reuse::free_rows(pair, setup.disc) {
+                // SAFETY: one contact at a time.
+                unsafe { *shared_rhs.get(ir) += f[r] };
+            }
+        }
+    }
+
+    /// The base states of this increment (open as open, the others stuck) and α F (`rhs`)
+    /// plus their loads.
+    fn base_load(
+        &self,
+        kept: &mut Option<KeptContactLoads>,
+        rhs: &[f64],
+    ) -> (Vec<ContactState>, Vec<f64>) {
+        let (setup, contacts) = (self.setup, self.contacts);
+        let states: Vec<ContactState> = contacts
+            .states
+            .iter()
+            .map(|&s| match s {
+                ContactState::Open => ContactState::Open,
+                _ => ContactState::Stick,
+            })
+            .collect();
+        // The contacts without prescribed DOFs: their kept sum, updated where the base state
+        // or the slip changed (an open contact's load is zero, a stuck one's its stick load).
+        let free = |i: usize| setup.prescribed[i].is_empty();
+        let kept = kept.get_or_insert_with(|| {
+            let mut sum = vec![0.0; rhs.len()];
+            self.by_colors(&|i| free(i).then_some(states[i]), &mut sum, None);
+            KeptContactLoads::new(&states, &contacts.slips, sum)
+        });
+        kept.update(
+            &states,
+            &contacts.slips,
+            free,
+            |i, state, slip, sign, out| {
+                if state != ContactState::Stick {
+                    return;
+                }
+                let f = setup.pairs[i].stick_load(slip);
+                for (r, ir) in super::factor_reuse::free_rows(&setup.pairs[i], setup.disc) {
+                    out[ir] += sign * f[r];
+                }
+            },
+        );
+        let mut base: Vec<f64> = rhs.iter().zip(kept.sum()).map(|(r, k)| r + k).collect();
+        // The contacts on prescribed DOFs, whose loads follow α.
+        self.by_colors(&|i| (!free(i)).then_some(states[i]), &mut base, None);
+        (states, base)
+    }
+}

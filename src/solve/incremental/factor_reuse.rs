@@ -1,0 +1,318 @@
+//! Solving a state iteration on the reference factorization A₀ with the changed contacts as a
+//! low-rank correction U E Uᵀ (Sherman–Morrison–Woodbury, see `low_rank.rs`), checked and
+//! corrected with the residual of the assembled matrix.
+
+use super::assemble::System;
+use super::increment::Increment;
+use super::matrix_values::MatrixValues;
+use super::options::{MAX_REFINEMENTS, REUSE_ACCURACY};
+use super::setup::Setup;
+use super::StickSlip;
+use crate::constraints::Discretization;
+use crate::contact::ContactPair;
+use crate::solve::low_rank::{Capacitance, LowRankCorrection, SparseColumn};
+use crate::solve::static_solve::{backward_tolerance, check_backward_error};
+use crate::Error;
+use fibercell_solver::{
+    backward_from_product, norm_inf, relative_from_product, CscRef, LinearSolver, SolveInfo,
+    SolveReport, SolverError,
+};
+
+/// A low-rank solve that reached `tolerance`: the solution, its backward error, its relative
+/// residual ‖b − Ax‖₂/‖b‖₂ and the correction steps it took.
+pub(super) struct LowRankSolve {
+    pub x: Vec<f64>,
+    pub backward_error: f64,
+    pub relative_residual: f64,
+    pub refinements: usize,
+}
+
+/// The solve report of a checked low-rank solution.
+pub(super) fn low_rank_report(r: &LowRankSolve) -> SolveReport {
+    SolveReport {
+        backend: "low-rank",
+        relative_residual: r.relative_residual,
+        backward_error: r.backward_error,
+        info: SolveInfo {
+            iterations: Some(r.refinements),
+            ..SolveInfo::default()
+        },
+    }
+}
+
+/// What a low-rank solution of one state iteration is checked against: the assembled matrix A
+/// and load b, and the backward error to reach.
+pub(super) struct ResidualCheck<'a> {
+    pub a: CscRef<'a>,
+    pub symmetric: bool,
+    pub b: &'a [f64],
+    pub tolerance: f64,
+}
+
+/// Corrects `first`, a solution of A x = b by the low-rank correction `cap` of the reference
+/// factorization `a0`, with the residual of the assembled A until the backward error is at
+/// most the check's tolerance; `None` when [`MAX_REFINEMENTS`] steps do not get there (or the
+/// capacitance matrix is singular).
+pub(super) fn refine_low_rank(
+    low_rank: &LowRankCorrection,
+    a0: &mut dyn LinearSolver,
+    cap: &Capacitance,
+    check: &ResidualCheck<'_>,
+    first: Result<Vec<f64>, SolverError>,
+) -> Result<Option<LowRankSolve>, SolverError> {
+    let ResidualCheck {
+        a,
+        symmetric,
+        b,
+        tolerance,
+    } = *check;
+    let Ok(mut x) = first else {
+        return Ok(None);
+    };
+    let mut ax = vec![0.0; b.len()];
+    let mut norm_a = None;
+    for refinements in 0..=MAX_REFINEMENTS {
+        let norm_a = *norm_a.get_or_insert_with(|| {
+            if symmetric {
+                a.mul_vec_symmetric_norm_par(&x, &mut ax)
+            } else {
+                a.mul_vec(&x, &mut ax);
+                norm_inf(a)
+            }
+        });
+        if refinements > 0 {
+            if symmetric {
+                a.mul_vec_symmetric_par(&x, &mut ax);
+            } else {
+                a.mul_vec(&x, &mut ax);
+            }
+        }
+        let backward_error = backward_from_product(norm_a, &ax, &x, b);
+        if !backward_error.is_finite() {
+            return Ok(None);
+        }
+        if backward_error <= tolerance {
+            return Ok(Some(LowRankSolve {
+                relative_residual: relative_from_product(&ax, b),
+                x,
+                backward_error,
+                refinements,
+            }));
+        }
+        if refinements == MAX_REFINEMENTS {
+            break;
+        }
+        let r: Vec<f64> = b.iter().zip(&ax).map(|(p, q)| p - q).collect();
+        let Ok(dx) = low_rank.solve(a0, cap, &r) else {
+            return Ok(None);
+        };
+        x.iter_mut().zip(&dx).for_each(|(xi, d)| *xi += d);
+    }
+    Ok(None)
+}
+
+/// The rows of `pair`'s block on free DOFs: (row in the block, free DOF).
+pub(super) fn free_rows<'a>(
+    pair: &'a ContactPair,
+    disc: &'a Discretization,
+) -> impl Iterator<Item = (usize, usize)> + 'a {
+    (0..pair.size()).filter_map(move |r| {
+        disc.reduced(6 * pair.jump.nodes[r / 6] + r % 6)
+            .map(|i| (r, i))
+    })
+}
+
+/// The column of U for basis row `k` of `pair`'s jump basis in the free DOFs.
+pub(super) fn low_rank_column(pair: &ContactPair, disc: &Discretization, k: usize) -> SparseColumn {
+    let g = pair.jump_basis()[k];
+    let mut col: SparseColumn = free_rows(pair, disc).map(|(r, i)| (i, g[r])).collect();
+    col.sort_unstable_by_key(|e| e.0);
+    col.dedup_by(|b, a| {
+        if a.0 == b.0 {
+            a.1 += b.1;
+            true
+        } else {
+            false
+        }
+    });
+    col.retain(|e| e.1 != 0.0);
+    col
+}
+
+impl StickSlip<'_, '_> {
+    /// Solves `system` on the reference factorization with the changed contacts as a low-rank
+    /// correction, when there is a reference and the correction is predicted cheaper than a
+    /// factorization (see [`super::factors::LowRankCost`]); `None` when it is not tried or
+    /// misses its accuracy (the next factorization then becomes the reference). The solution
+    /// comes with its capacitance while unchecked: not in the last iteration allowed, the
+    /// residual check waits until the contact states are consistent with the solution (the
+    /// states in between only steer the iteration; see [`StickSlip::confirm`]).
+    pub(super) fn solve_low_rank(
+        &mut self,
+        inc: &mut Increment,
+        system: &mut System,
+        iteration: usize,
+    ) -> Result<Option<(LowRankSolve, Option<Capacitance>)>, Error> {
+        let StickSlip {
+            setup,
+            factors,
+            matrix,
+            ..
+        } = self;
+        let opts = setup.opts;
+        let (Some(changes), Some(a0), true) = (
+            system.changes.as_deref(),
+            factors.backends.reference.as_mut(),
+            setup.n_free() > 0 && !factors.refresh_reference,
+        ) else {
+            return Ok(None);
+        };
+        let low_rank = &mut factors.low_rank;
+        let (order, new) = low_rank.size_of(changes);
+        let affordable = match opts.max_capacitance_order {
+            Some(max) => order <= max,
+            None => factors.cost.worth(order),
+        };
+        if low_rank.len() + new > opts.max_low_rank_columns {
+            factors.refresh_reference = true;
+            return Ok(None);
+        }
+        if !affordable {
+            return Ok(None);
+        }
+        let locate = |e| setup.locate(e);
+        let column = |c: usize, k: usize| low_rank_column(&setup.pairs[c], setup.disc, k);
+        let x0 = match factors.reference_solution.take() {
+            Some(x0) => {
+                low_rank
+                    .extend(a0.as_mut(), changes, column)
+                    .map_err(locate)?;
+                x0
+            }
+            // b₀ = b − U Δχ, the load with every contact as in the reference: from the
+            // references of two earlier increments when affine in α, else its forward half
+            // along with the new columns' forward solves.
+            None => {
+                let (alpha, affine, rhs) = (inc.alpha, &mut factors.affine, &system.rhs);
+                let mut solved_b0 = None;
+                let x0 = low_rank
+                    .extend_with_reference(
+                        a0.as_mut(),
+                        changes,
+                        column,
+                        |low_rank| {
+                            let load = low_rank.active_load(changes);
+                            let shift = low_rank.spread(changes, &load);
+                            rhs.iter().zip(&shift).map(|(b, s)| b - s).collect()
+                        },
+                        |low_rank, b0| {
+                            let known = affine.predict(alpha, b0, low_rank);
+                            if known.is_none() {
+                                solved_b0 = Some(b0.to_vec());
+                            }
+                            known
+                        },
+                    )
+                    .map_err(locate)?;
+                if let Some(b0) = solved_b0 {
+                    affine.record(alpha, b0, &x0);
+                }
+                x0
+            }
+        };
+        inc.low_rank_order = inc.low_rank_order.max(order);
+        let started = std::time::Instant::now();
+        let cap = low_rank.capacitance(changes);
+        if order > 0 {
+            factors.cost.lu_rate = (2.0 / 3.0 * (order as f64).powi(3)
+                / started.elapsed().as_secs_f64().max(1e-9))
+            .max(1e8);
+        }
+        let load = low_rank.active_load(changes);
+        let first = low_rank.solve_from(a0.as_mut(), &cap, &x0, &load);
+        factors.reference_solution = Some(x0);
+        let solved = match first {
+            Ok(x) if iteration < opts.max_state_iterations && x.iter().all(|v| v.is_finite()) => {
+                Some((
+                    LowRankSolve {
+                        x,
+                        backward_error: f64::NAN,
+                        relative_residual: f64::NAN,
+                        refinements: 0,
+                    },
+                    Some(cap),
+                ))
+            }
+            first => {
+                let check = residual_check(setup, matrix, system)?;
+                refine_low_rank(&factors.low_rank, a0.as_mut(), &cap, &check, first)
+                    .map_err(locate)?
+                    .map(|r| (r, None))
+            }
+        };
+        factors.refresh_reference = solved.is_none();
+        inc.lap(|t| &mut t.factor_reuse);
+        Ok(solved)
+    }
+
+    /// Checks an unchecked low-rank solution `x` of `system` with capacitance `cap` against
+    /// the assembled matrix and corrects it; its report, `None` when it misses the accuracy
+    /// (the same states are then solved again on a new reference). A corrected solution
+    /// replaces the run's displacements.
+    pub(super) fn confirm(
+        &mut self,
+        inc: &mut Increment,
+        system: &mut System,
+        cap: &Capacitance,
+        x: Vec<f64>,
+    ) -> Result<Option<(SolveReport, bool)>, Error> {
+        let StickSlip {
+            setup,
+            factors,
+            matrix,
+            q,
+            ..
+        } = self;
+        let a0 = factors
+            .backends
+            .reference
+            .as_mut()
+            .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "factorize")))?;
+        let check = residual_check(setup, matrix, system)?;
+        let checked = refine_low_rank(&factors.low_rank, a0.as_mut(), cap, &check, Ok(x))
+            .map_err(|e| setup.locate(e))?;
+        inc.lap(|t| &mut t.factor_reuse);
+        let Some(r) = checked else {
+            factors.refresh_reference = true;
+            return Ok(None);
+        };
+        inc.reuse_iterations += r.refinements;
+        check_backward_error(&setup.opts.solve, r.backward_error, &inc.name())?;
+        let refined = r.refinements > 0;
+        if refined {
+            *q = setup.disc.generalized(&r.x, inc.alpha);
+        }
+        Ok(Some((low_rank_report(&r), refined)))
+    }
+}
+
+/// The residual check of a low-rank solution of `system`: its assembled matrix (the values
+/// brought up to date first) and load, and the accuracy of a direct solve.
+fn residual_check<'s>(
+    setup: &'s Setup<'_>,
+    matrix: &'s mut MatrixValues,
+    system: &'s mut System,
+) -> Result<ResidualCheck<'s>, Error> {
+    matrix.catch_up(
+        &mut system.values_behind,
+        &setup.pattern,
+        &setup.pairs,
+        system.changes.as_deref(),
+    );
+    Ok(ResidualCheck {
+        a: setup.pattern.matrix(&matrix.values)?,
+        symmetric: !system.nonsymmetric,
+        b: &system.rhs,
+        tolerance: REUSE_ACCURACY * backward_tolerance(&setup.opts.solve),
+    })
+}

@@ -1,0 +1,145 @@
+//! Solving a state iteration directly: a factorization of the assembled matrix (unless the
+//! same states were factorized last), which becomes the reference of the low-rank solves when
+//! the first symmetric one or when the correction outgrew its columns or accuracy.
+
+use super::assemble::System;
+use super::contact_states::ContactStates;
+use super::factors::ReferenceBlock;
+use super::increment::Increment;
+use super::StickSlip;
+use crate::contact::Friction;
+use crate::solve::low_rank::Reference;
+use crate::solve::{SolverConfig, SolverKind};
+use crate::Error;
+use fibercell_solver::{solve_checked, SolveReport, SolverError};
+
+impl StickSlip<'_, '_> {
+    /// Factorizes `system` if needed and solves it: the solution and its report (none without
+    /// unknowns).
+    pub(super) fn solve_direct(
+        &mut self,
+        inc: &mut Increment,
+        system: &mut System,
+    ) -> Result<(Vec<f64>, Option<SolveReport>), Error> {
+        let StickSlip {
+            setup,
+            contacts,
+            factors,
+            matrix,
+            ..
+        } = self;
+        let locate = |e| setup.locate(e);
+        let n_free = setup.n_free();
+        matrix.catch_up(
+            &mut system.values_behind,
+            &setup.pattern,
+            &setup.pairs,
+            system.changes.as_deref(),
+        );
+        let a = setup.pattern.matrix(&matrix.values)?;
+        let nonsymmetric = system.nonsymmetric;
+        // The first symmetric factorization, or the next after the correction outgrew its
+        // columns or its accuracy, becomes the reference (in its own solver).
+        let make_reference = !nonsymmetric
+            && setup.low_rank_possible
+            && n_free > 0
+            && (factors.reference.is_none() || factors.refresh_reference);
+        let backends = &mut factors.backends;
+        let (slot, kind) = if nonsymmetric {
+            (&mut backends.general, SolverKind::FaerLu)
+        } else if make_reference {
+            (&mut backends.reference, setup.opts.solve.solver)
+        } else {
+            (&mut backends.symmetric, setup.opts.solve.solver)
+        };
+        if slot.is_none() {
+            let mut s = SolverConfig {
+                kind,
+                ..setup.solver_config.clone()
+            }
+            .build()?;
+            s.analyze(a).map_err(locate)?;
+            *slot = Some(s);
+        }
+        let solver = slot
+            .as_mut()
+            .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "analyze")))?;
+        let key = (
+            nonsymmetric,
+            contacts.states.clone(),
+            contacts.directions.clone(),
+            contacts
+                .perpendicular
+                .iter()
+                .map(|p| p.0)
+                .collect::<Vec<f64>>(),
+        );
+        inc.lap(|t| &mut t.factorize);
+        let mut refactorized = false;
+        if make_reference || factors.factorized.as_ref() != Some(&key) {
+            let started = std::time::Instant::now();
+            solver.factorize(a).map_err(locate)?;
+            inc.factorizations += 1;
+            if !nonsymmetric {
+                factors.cost.factorize = Some(started.elapsed().as_secs_f64());
+            }
+            if !make_reference {
+                factors.factorized = Some(key);
+            } else {
+                factors.refresh_reference = false;
+                factors.reference = Some(reference_blocks(setup, contacts));
+                refactorized = true;
+                matrix.reference.copy_from_slice(&matrix.values);
+                matrix.changed_since_reference = Some(Vec::new());
+                factors.low_rank.reset();
+                factors.affine.clear();
+                // The initial states are all-stick unless frictionless (sliding).
+                if let Some(hook) = factors.on_all_stick.take() {
+                    let friction = setup.friction();
+                    if friction != Friction::None
+                        && contacts
+                            .states
+                            .iter()
+                            .zip(&setup.pairs)
+                            .all(|(s, p)| *s == ContactStates::initial(p, friction))
+                    {
+                        hook(solver.as_mut(), a)?;
+                    }
+                }
+            }
+            inc.lap(|t| &mut t.factorize);
+        }
+        if n_free == 0 {
+            return Ok((Vec::new(), None));
+        }
+        let (x, r) = solve_checked(solver.as_mut(), a, &system.rhs, 1).map_err(locate)?;
+        if refactorized {
+            // The reference's own load: A₀⁻¹ b₀ of this increment.
+            factors.reference_solution = Some(Reference::Full(x.clone()));
+        }
+        Ok((x, Some(r)))
+    }
+}
+
+/// Every contact's block as the reference factorization has it.
+fn reference_blocks(
+    setup: &super::setup::Setup<'_>,
+    contacts: &ContactStates,
+) -> Vec<ReferenceBlock> {
+    (0..setup.pairs.len())
+        .map(|i| {
+            let state = contacts.block(i);
+            ReferenceBlock {
+                stiffness: setup.pairs[i].block_coefficients(
+                    &state,
+                    contacts.friction_of(i),
+                    setup.stabilization,
+                ),
+                state,
+                friction: contacts.friction_of(i),
+                anchor: contacts.perpendicular[i].1,
+                slip: contacts.slips[i],
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,290 @@
+//! The incremental stick/slip solver (thesis §4.3 "Contact solution algorithm"): the load is
+//! applied in N increments α_n = n/N; all closed contacts start in stick; inside each increment
+//! the contact contributions are rebuilt for the current states, the system is solved, and every
+//! contact is re-classified by a return mapping — open if it does not penetrate, stick if the
+//! trial tangential force p_T (Eᵀ B q − s) lies within the friction bound (μN or G), otherwise
+//! slip at the bound along the trial direction — until no state changes.
+//!
+//! A contact that changes its state or slip direction four times within one increment (the
+//! discrete penalty problem can have no consistent state for it: e.g. closed it is pulled apart,
+//! open it penetrates) is held in its state for the rest of the increment; the count is
+//! reported per increment.
+//!
+//! The pattern (elements ∪ all candidate contact blocks) and each backend's symbolic analysis are
+//! built once. The first symmetric factorization is the reference: later systems are its matrix
+//! plus the changed contacts' blocks, assembled as such and solved as a low-rank correction of
+//! it while that is cheaper than refactorizing (see [`IncrementalOptions::reuse_factor`]).
+//! Otherwise systems with a Coulomb-sliding contact are nonsymmetric and go to LU, all others
+//! to the chosen symmetric backend.
+//!
+//! The solver is a [`StickSlip`] object built once per run ([`setup`]); each increment reads
+//! like the algorithm — assemble ([`assemble`]), solve with factor reuse ([`factor_reuse`],
+//! [`factorize`]), classify by the return mapping ([`classify`], [`return_mapping`]), and at
+//! convergence commit ([`commit`]).
+
+mod assemble;
+mod classify;
+mod commit;
+mod contact_states;
+mod elastic;
+mod factor_reuse;
+mod factorize;
+mod factors;
+mod increment;
+mod matrix_values;
+mod options;
+mod records;
+mod return_mapping;
+mod setup;
+mod stabilizer;
+
+pub use options::{IncrementalOptions, Progress, BOUND_TOLERANCE, MAX_LOW_RANK_COLUMNS};
+pub use records::{
+    ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
+};
+
+use assemble::System;
+use classify::Classified;
+use commit::EnergyHistory;
+use contact_states::ContactStates;
+use factors::Factors;
+use increment::Increment;
+use matrix_values::MatrixValues;
+use setup::Setup;
+
+use super::kept_contact_loads::KeptContactLoads;
+use super::low_rank::Capacitance;
+use super::static_solve::check_backward_error;
+use crate::constraints::Discretization;
+use crate::contact::{ContactSet, ContactSide};
+use crate::model::Model;
+use crate::Error;
+use fibercell_solver::{CscRef, LinearSolver, SolveReport};
+
+/// Runs the incremental stick/slip analysis of `model` (its supports, loads and contacts).
+pub fn solve_incremental(
+    model: &Model,
+    opts: &IncrementalOptions,
+) -> Result<IncrementalSolution, Error> {
+    if model.cell.is_some() && model.supports.is_empty() {
+        return Err(Error::CellWithoutSupports);
+    }
+    let set = ContactSet::build(model)?;
+    run_incremental(model, &Discretization::supported(model), set, opts, None)
+}
+
+/// Called once with the run's first reference factorization when that is the all-stick matrix
+/// (every closed contact in stick, every other open; open contacts carry their stabilizing
+/// springs when [`IncrementalOptions::stabilization`] > 0): the factorized solver and the
+/// matrix. The elasto-plastic curve solves its six elastic cell problems on it.
+pub(crate) type OnAllStick<'h> =
+    &'h mut dyn FnMut(&mut dyn LinearSolver, CscRef<'_>) -> Result<(), Error>;
+
+/// The incremental analysis on any discretization (supported structure or periodic cell).
+pub(crate) fn run_incremental(
+    model: &Model,
+    disc: &Discretization,
+    set: ContactSet,
+    opts: &IncrementalOptions,
+    on_all_stick: Option<OnAllStick<'_>>,
+) -> Result<IncrementalSolution, Error> {
+    let path = load_path(opts)?;
+    let mut solver = StickSlip::new(Setup::new(model, disc, set, opts)?, on_all_stick);
+    for (step, &alpha) in (1..).zip(&path) {
+        solver.increment(step, alpha)?;
+        if let Some(p) = &opts.progress {
+            (p.0)(step, path.len());
+        }
+        if opts
+            .deadline
+            .is_some_and(|d| std::time::Instant::now() >= d)
+        {
+            break;
+        }
+    }
+    Ok(solver.out)
+}
+
+/// The load factors of the increments: the options' path, else α_n = n/N.
+fn load_path(opts: &IncrementalOptions) -> Result<Vec<f64>, Error> {
+    let path: Vec<f64> = match &opts.path {
+        Some(p) => p.clone(),
+        None => (1..=opts.steps)
+            .map(|n| n as f64 / opts.steps as f64)
+            .collect(),
+    };
+    if path.is_empty() {
+        return Err(Error::InvalidOption(
+            "the number of increments must be at least 1".into(),
+        ));
+    }
+    if let Some(a) = path.iter().find(|a| !a.is_finite()) {
+        return Err(Error::InvalidOption(format!(
+            "load factor {a} is not finite"
+        )));
+    }
+    Ok(path)
+}
+
+/// The stick/slip solver of one run (thesis §4.3): its fixed data, the contacts' states, the
+/// factorizations and matrix values, and the results so far.
+pub(crate) struct StickSlip<'a, 'h> {
+    setup: Setup<'a>,
+    contacts: ContactStates,
+    factors: Factors<'h>,
+    matrix: MatrixValues,
+    /// The loads of the contacts without prescribed DOFs in their base states (open as open,
+    /// the others stuck) with the slips they were summed at: kept across increments and
+    /// updated at the contacts whose base state or slip changed (few per increment), instead
+    /// of summed anew.
+    kept_loads: Option<KeptContactLoads>,
+    /// Generalized displacements of the last solve.
+    q: Vec<f64>,
+    energy: EnergyHistory,
+    out: IncrementalSolution,
+}
+
+/// A state iteration's solution: the unknowns, the solve's report (none while a low-rank
+/// solution waits for its check, or without unknowns), and the capacitance of that check.
+struct Solved {
+    x: Vec<f64>,
+    report: Option<SolveReport>,
+    unchecked: Option<Capacitance>,
+}
+
+impl<'a, 'h> StickSlip<'a, 'h> {
+    fn new(setup: Setup<'a>, on_all_stick: Option<OnAllStick<'h>>) -> Self {
+        let n = 6 * setup.disc.n_gnodes();
+        StickSlip {
+            contacts: ContactStates::new(&setup),
+            factors: Factors::new(setup.n_free(), setup.pairs.len(), on_all_stick),
+            matrix: MatrixValues::new(&setup.k_elastic),
+            kept_loads: None,
+            q: vec![0.0; n],
+            energy: EnergyHistory {
+                previous: (vec![0.0; n], vec![0.0; n]),
+                ..EnergyHistory::default()
+            },
+            out: IncrementalSolution {
+                contacts: setup.set.clone(),
+                increments: Vec::new(),
+                contact_results: Vec::new(),
+                displacements: Vec::new(),
+                reactions: Vec::new(),
+            },
+            setup,
+        }
+    }
+
+    /// Increment `step` to load factor `alpha`: state iterations — assemble, solve, classify
+    /// — until no contact changes, then commit.
+    fn increment(&mut self, step: usize, alpha: f64) -> Result<(), Error> {
+        let mut inc = Increment::new(&self.setup, step, alpha);
+        // New α and committed slips: a new reference load.
+        self.factors.reference_solution = None;
+        self.contacts.switches.fill(0);
+        let max_iterations = self.setup.opts.max_state_iterations;
+        for iteration in 1..=max_iterations {
+            let mut system = self.assemble(&mut inc)?;
+            let solved = self.solve(&mut inc, &mut system, iteration)?;
+            let mut classified = self.classify();
+            let mut report = solved.report;
+            if let (true, Some(cap)) = (classified.changed.is_empty(), &solved.unchecked) {
+                inc.lap(|t| &mut t.classify);
+                let Some((checked, refined)) =
+                    self.confirm(&mut inc, &mut system, cap, solved.x)?
+                else {
+                    continue; // the same states again, on a new reference
+                };
+                report = Some(checked);
+                if refined {
+                    classified = self.classify();
+                }
+            }
+            let Classified { trials, changed } = classified;
+            if changed.is_empty() {
+                inc.lap(|t| &mut t.classify);
+                self.commit(inc, iteration, &trials, report);
+                return Ok(());
+            }
+            if iteration == max_iterations {
+                return Err(Error::ContactNotConverged {
+                    step,
+                    iterations: iteration,
+                    contacts: changed.iter().map(|&i| self.describe(i)).collect(),
+                });
+            }
+            let direction_tol = self.setup.direction_tol;
+            self.contacts.advance(
+                &self.setup.pairs,
+                &trials,
+                &changed,
+                iteration,
+                direction_tol,
+            );
+            inc.lap(|t| &mut t.classify);
+        }
+        Err(Error::InvalidOption("no state iteration ran".into()))
+    }
+
+    /// Solves `system`: on the reference factorization with a low-rank correction when that
+    /// is possible and cheaper, else directly.
+    fn solve(
+        &mut self,
+        inc: &mut Increment,
+        system: &mut System,
+        iteration: usize,
+    ) -> Result<Solved, Error> {
+        let solved = match self.solve_low_rank(inc, system, iteration)? {
+            Some((r, unchecked)) => {
+                inc.factor_reuses += 1;
+                inc.reuse_iterations += r.refinements;
+                let report = unchecked
+                    .is_none()
+                    .then(|| factor_reuse::low_rank_report(&r));
+                Solved {
+                    x: r.x,
+                    report,
+                    unchecked,
+                }
+            }
+            None => {
+                let (x, report) = self.solve_direct(inc, system)?;
+                Solved {
+                    x,
+                    report,
+                    unchecked: None,
+                }
+            }
+        };
+        let bwd = solved.report.as_ref().map_or(0.0, |r| r.backward_error);
+        check_backward_error(&self.setup.opts.solve, bwd, &inc.name())?;
+        inc.lap(|t| &mut t.solve);
+        self.q = self.setup.disc.generalized(&solved.x, inc.alpha);
+        Ok(solved)
+    }
+
+    /// Contact i with its two sides, for error messages.
+    fn describe(&self, i: usize) -> String {
+        let (model, set) = (self.setup.model, &self.setup.set);
+        let o = &set.origins[i];
+        let side = |s: ContactSide| match s {
+            ContactSide::Node(n) => format!("node {}", model.nodes[n].id),
+            ContactSide::Point { element, xi } => {
+                let e = model.elements()[element];
+                format!(
+                    "fiber {} at nodes {}–{} ξ={xi:.3}",
+                    model.fibers[e.fiber].id,
+                    model.nodes[e.nodes[0]].id,
+                    model.nodes[e.nodes[1]].id
+                )
+            }
+        };
+        format!(
+            "contact {} ({} / {})",
+            i + 1,
+            side(o.sides[0]),
+            side(o.sides[1])
+        )
+    }
+}

@@ -1,0 +1,136 @@
+//! What a stick/slip run is told: increments, backends, the contact treatment, and the
+//! tolerances of its state iteration.
+
+use super::super::SolveOptions;
+
+/// A callback told after every increment: (increments done, increments in all).
+#[derive(Clone)]
+pub struct Progress(pub std::sync::Arc<dyn Fn(usize, usize) + Send + Sync>);
+
+impl std::fmt::Debug for Progress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Progress(callback)")
+    }
+}
+
+/// Options of [`solve_incremental`](super::solve_incremental).
+#[derive(Clone, Debug)]
+pub struct IncrementalOptions {
+    /// Number of load increments N ≥ 1.
+    pub steps: usize,
+    /// Backend and checks for the symmetric systems (Coulomb sliding always uses faer LU).
+    pub solve: SolveOptions,
+    /// Largest number of state iterations inside one increment.
+    pub max_state_iterations: usize,
+    /// Load factors of the increments (default: α_n = n/N, n = 1…N); any sequence, e.g. up to 1,
+    /// back to 0 and up again for a load–unload–reload path. Overrides `steps`.
+    pub path: Option<Vec<f64>>,
+    /// Thesis Remark 4.38: every contact slides along the direction of its tangential relative
+    /// displacement in a frictionless pre-run, instead of the trial direction of the return
+    /// mapping (the default, and the more faithful treatment).
+    pub fixed_slip_direction: bool,
+    /// Called after every increment (e.g. to drive a progress bar).
+    pub progress: Option<Progress>,
+    /// Relative stiffness ε of the stabilizing springs (default 0: none). An open contact keeps
+    /// ε (K_N + K_T^st + K_R) and a sliding one ε K_T^st, linear springs on the contact jump with
+    /// no prestress. A fiber that loses all its closed contacts (a rattler) or whose contacts all
+    /// slide one way is otherwise a mechanism and the system is singular; with ε ≈ 1e-8 it
+    /// follows its neighbours and the springs carry forces of relative size ε, included in the
+    /// reactions.
+    pub stabilization: f64,
+    /// A fixed contact topology: initially closed contacts never open (the normal spring is
+    /// bilateral, N may be negative, a tension) and open ones never close; only stick and slip
+    /// evolve, with a Coulomb bound μ max(N, 0). A model of bonded or consolidated mats, whose
+    /// just-touching contacts would otherwise open under the smallest strain and chatter.
+    pub bonded: bool,
+    /// After the first factorization, solve on it: the contacts whose block changed since (a
+    /// state, a slip direction or the tangent across it) are a low-rank correction U E Uᵀ in
+    /// their jump rows, solved by the Sherman–Morrison–Woodbury formula with S = Uᵀ A₀⁻¹ U
+    /// kept across iterations and increments (see `low_rank.rs`), while its dense capacitance
+    /// factorization is predicted cheaper than refactorizing (measured times); the result is
+    /// corrected with the residual of the assembled matrix until its backward error is 10⁵
+    /// times below the accepted one, as accurate as a direct solve, else the matrix is
+    /// refactorized and becomes the new reference (default true). Needs a direct symmetric
+    /// backend; Coulomb sliding (a nonsymmetric E) is solved on the symmetric factorization.
+    pub reuse_factor: bool,
+    /// Columns of the low-rank correction kept on one reference factorization; one more
+    /// refactorizes the current matrix as the new reference. S takes 8 bytes × this squared
+    /// (default [`MAX_LOW_RANK_COLUMNS`], 512 MB).
+    pub max_low_rank_columns: usize,
+    /// A state iteration whose capacitance matrix is larger than this factorizes its matrix
+    /// directly instead (the reference stays for the iterations after); `None` (default):
+    /// decided by the measured costs, a low-rank solve while its capacitance factorization is
+    /// predicted cheaper than a factorization. A bound makes the choice independent of the
+    /// machine's timings.
+    pub max_capacitance_order: Option<usize>,
+    /// Stop after the increment during which this instant passes (default: none); the solution
+    /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
+    pub deadline: Option<std::time::Instant>,
+    /// Solve Coulomb sliding with its consistent tangent K_T^sl = μ p_N Bᵀd nᵀB (4.63), a
+    /// nonsymmetric system for faer LU. Default false: each sliding contact's friction force
+    /// is a load at the bound c + μ max(N, 0) of the state iteration's last normal force N,
+    /// iterated until no bound moves by more than [`BOUND_TOLERANCE`] of itself (a fixed point
+    /// on the bounds, as for Tresca friction with the bound updated), so every system stays
+    /// symmetric for Cholesky and the low-rank corrections; at convergence both satisfy the
+    /// same Coulomb law.
+    pub consistent_coulomb_tangent: bool,
+}
+
+/// The relative change of a sliding Coulomb contact's bound c + μ max(N, 0) below which the
+/// fixed point on the bounds has converged (see
+/// [`IncrementalOptions::consistent_coulomb_tangent`]).
+pub const BOUND_TOLERANCE: f64 = 1e-8;
+
+/// State iterations of an increment after which the bounds of the Coulomb fixed point move by
+/// half the step (see the update in the state iteration).
+pub(super) const BOUND_RELAXATION_AFTER: usize = 10;
+
+/// State iterations of an increment with the Coulomb fixed point after which a sliding
+/// contact's changes of direction or bound count as switches (see [`CHATTER_SWITCHES`]).
+pub(super) const SETTLING_ITERATIONS: usize = 20;
+
+impl Default for IncrementalOptions {
+    fn default() -> Self {
+        IncrementalOptions {
+            steps: 10,
+            solve: SolveOptions::default(),
+            max_state_iterations: 50,
+            path: None,
+            fixed_slip_direction: false,
+            progress: None,
+            stabilization: 0.0,
+            bonded: false,
+            reuse_factor: true,
+            max_low_rank_columns: MAX_LOW_RANK_COLUMNS,
+            max_capacitance_order: None,
+            deadline: None,
+            consistent_coulomb_tangent: false,
+        }
+    }
+}
+
+/// State switches of one contact within an increment after which it is held in its state.
+pub(super) const CHATTER_SWITCHES: usize = 4;
+
+/// A sliding contact's direction has converged when the change |Δd| times its slip |u_t − s|
+/// (the tangential displacement across the old direction the change stands for) is below this
+/// fraction of the model size. Newton's iteration on the directions converges quadratically
+/// down to roundoff, which on the benchmark's S cell reaches 1e-11 of the size for barely
+/// sliding contacts: with 1e-12 or 1e-11 here some still chattered until held, with 1e-10
+/// none, and the end resultant of the curve moved by less than 2e-10 of itself.
+pub(super) const SLIP_DIRECTION_TOLERANCE: f64 = 1e-10;
+
+/// The backward error a factor-reuse CG solve must reach, relative to the accepted one of a
+/// direct solve. The slip directions are read off the last digits of the tangential
+/// displacements, so a CG solve must be as accurate as a direct one: at 1e-3 the directions of
+/// barely sliding contacts wandered by 1e-3 between iterations (measured on the S cell).
+pub(super) const REUSE_ACCURACY: f64 = 1e-5;
+
+/// Columns of the low-rank correction kept on one factorization before refactorizing, by
+/// default: S, their dense products, then takes 8 bytes × this squared (512 MB).
+pub const MAX_LOW_RANK_COLUMNS: usize = 8192;
+
+/// Correction steps x += W (b − A x) after a low-rank solve W ≈ A⁻¹ before it falls back to a
+/// factorization (the correction subtracts stick springs far stiffer than the fibers, which
+/// costs digits that one or two steps restore).
+pub(super) const MAX_REFINEMENTS: usize = 3;

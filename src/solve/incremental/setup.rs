@@ -1,0 +1,206 @@
+//! What a stick/slip run builds once: the contact pairs on generalized nodes, the pattern of
+//! elements and every candidate contact block, the elastic values and load, the contact
+//! colors for parallel scattering, and the run's contact law and tolerances.
+
+use super::elastic::Elastic;
+use super::options::SLIP_DIRECTION_TOLERANCE;
+use super::return_mapping::Law;
+use super::IncrementalOptions;
+use crate::assembly::{color_blocks, Pattern};
+use crate::constraints::Discretization;
+use crate::contact::{ContactPair, ContactSet, Friction};
+use crate::model::Model;
+use crate::solve::SolverConfig;
+use crate::Error;
+use fibercell_solver::SolverError;
+use nalgebra::{Vector2, Vector3};
+
+/// Everything of a run that does not change with the increments.
+pub(super) struct Setup<'a> {
+    pub model: &'a Model,
+    pub disc: &'a Discretization,
+    pub opts: &'a IncrementalOptions,
+    /// The contacts as found (pairs on the model's nodes, origins).
+    pub set: ContactSet,
+    /// Contact jumps on generalized nodes: B T.
+    pub pairs: Vec<ContactPair>,
+    pub law: Law,
+    /// Coulomb sliding by a fixed point on the bounds (see
+    /// [`IncrementalOptions::consistent_coulomb_tangent`]).
+    pub bound_fixed_point: bool,
+    /// Per contact, the slip direction of a frictionless pre-run (thesis Remark 4.38), when
+    /// [`IncrementalOptions::fixed_slip_direction`] asks for it.
+    pub fixed: Vec<Option<Vector2<f64>>>,
+    pub elastic: Elastic,
+    /// Elements ∪ every candidate contact block, on the free DOFs.
+    pub pattern: Pattern,
+    /// K of the elements in the pattern's slots.
+    pub k_elastic: Vec<f64>,
+    /// Contacts by color: no two of a color share a generalized node (the driver, which has no
+    /// rows, aside), so a color's contacts are scattered in parallel.
+    pub contact_colors: Vec<Vec<usize>>,
+    /// The elastic load at α = 1: F and the elements' products with prescribed DOFs.
+    pub rhs_full: Vec<f64>,
+    /// The nodal loads F on the free DOFs (α = 1).
+    pub applied_free: Vec<f64>,
+    /// The nodal loads summed per DOF (α = 1).
+    pub applied_full: [f64; 6],
+    /// Per contact, its block columns on prescribed DOFs (their products go to the load).
+    pub prescribed: Vec<Vec<usize>>,
+    pub solver_config: SolverConfig,
+    /// Low-rank solves need a direct symmetric backend.
+    pub low_rank_possible: bool,
+    /// Lengths below this are roundoff (1e-12 of the model size).
+    pub length_tol: f64,
+    /// See [`SLIP_DIRECTION_TOLERANCE`].
+    pub direction_tol: f64,
+    pub stabilization: f64,
+}
+
+impl<'a> Setup<'a> {
+    /// Checks the options and builds the run's fixed data.
+    pub fn new(
+        model: &'a Model,
+        disc: &'a Discretization,
+        set: ContactSet,
+        opts: &'a IncrementalOptions,
+    ) -> Result<Self, Error> {
+        if opts.max_state_iterations == 0 {
+            return Err(Error::InvalidOption(
+                "max_state_iterations must be at least 1".into(),
+            ));
+        }
+        let stabilization = opts.stabilization;
+        if !(stabilization.is_finite() && stabilization >= 0.0) {
+            return Err(Error::InvalidOption(format!(
+                "stabilization = {stabilization} must be finite and ≥ 0"
+            )));
+        }
+        let friction = model
+            .contact
+            .as_ref()
+            .map_or(Friction::None, |c| c.friction);
+        let bonded = opts.bonded || model.contact.as_ref().is_some_and(|c| c.bonded);
+        let bound_fixed_point = matches!(friction, Friction::Coulomb { mu, .. } if mu > 0.0)
+            && !opts.consistent_coulomb_tangent;
+        let fixed = fixed_directions(model, disc, &set, opts)?;
+        let pairs: Vec<ContactPair> = set.pairs.iter().map(|p| disc.contact_pair(p)).collect();
+        let elastic = Elastic::new(model, disc);
+        let mut blocks: Vec<Vec<usize>> = (0..model.elements().len())
+            .map(|e| elastic.gnodes_of(model, e).to_vec())
+            .collect();
+        blocks.extend(pairs.iter().map(|p| p.jump.nodes.clone()));
+        let block_refs: Vec<&[usize]> = blocks.iter().map(|b| &b[..]).collect();
+        let pattern = Pattern::from_blocks(
+            disc.reduced_indices(),
+            disc.n_free(),
+            &block_refs,
+            model.elements().len(),
+        )?;
+        let mut k_elastic = vec![0.0; pattern.nnz()];
+        elastic.fill(model, &pattern, &mut k_elastic, opts.solve.fill)?;
+        let contact_colors = color_blocks(
+            disc.n_gnodes(),
+            pairs.iter().map(|p| &p.jump.nodes[..]),
+            disc.driver(),
+        );
+        let mut applied_full = [0.0; 6];
+        for l in &model.loads {
+            applied_full[l.dof.index()] += l.value;
+        }
+        let prescribed = pairs
+            .iter()
+            .map(|p| {
+                (0..p.size())
+                    .filter(|&c| disc.reduced(6 * p.jump.nodes[c / 6] + c % 6).is_none())
+                    .collect()
+            })
+            .collect();
+        let solver_config = opts.solve.solver_config(disc.node_block_starts());
+        let low_rank_possible = opts.reuse_factor
+            && solver_config
+                .build()
+                .is_ok_and(|s| !s.capabilities().iterative);
+        Ok(Setup {
+            rhs_full: elastic.rhs(model, disc),
+            applied_free: Elastic::applied(model, disc),
+            model,
+            disc,
+            opts,
+            set,
+            pairs,
+            law: Law { friction, bonded },
+            bound_fixed_point,
+            fixed,
+            elastic,
+            pattern,
+            k_elastic,
+            contact_colors,
+            applied_full,
+            prescribed,
+            solver_config,
+            low_rank_possible,
+            length_tol: 1e-12 * model.size(),
+            direction_tol: SLIP_DIRECTION_TOLERANCE * model.size(),
+            stabilization,
+        })
+    }
+
+    /// The run's friction law.
+    pub fn friction(&self) -> Friction {
+        self.law.friction
+    }
+
+    /// Unknowns of the linear systems.
+    pub fn n_free(&self) -> usize {
+        self.disc.n_free()
+    }
+
+    /// A solver error with its row named as a node and DOF of the model.
+    pub fn locate(&self, e: SolverError) -> Error {
+        self.disc.locate(self.model, e)
+    }
+}
+
+/// The slip directions of a frictionless pre-run when
+/// [`IncrementalOptions::fixed_slip_direction`] asks for them (thesis Remark 4.38), else none.
+fn fixed_directions(
+    model: &Model,
+    disc: &Discretization,
+    set: &ContactSet,
+    opts: &IncrementalOptions,
+) -> Result<Vec<Option<Vector2<f64>>>, Error> {
+    let friction = model
+        .contact
+        .as_ref()
+        .map_or(Friction::None, |c| c.friction);
+    if !opts.fixed_slip_direction || friction == Friction::None {
+        return Ok(vec![None; set.pairs.len()]);
+    }
+    let mut frictionless = model.clone();
+    if let Some(c) = frictionless.contact.as_mut() {
+        c.friction = Friction::None;
+    }
+    let pre = super::run_incremental(
+        &frictionless,
+        disc,
+        set.clone(),
+        &IncrementalOptions {
+            fixed_slip_direction: false,
+            deadline: None,
+            ..opts.clone()
+        },
+        None,
+    )?;
+    let last = pre.contact_results.last().cloned().unwrap_or_default();
+    Ok(set
+        .pairs
+        .iter()
+        .zip(&last)
+        .map(|(p, r)| {
+            let g = Vector3::from(r.relative_tangential);
+            let d = Vector2::new(p.tangents[0].dot(&g), p.tangents[1].dot(&g));
+            (d.norm() > 0.0).then(|| d / d.norm())
+        })
+        .collect())
+}
