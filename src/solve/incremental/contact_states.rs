@@ -101,15 +101,15 @@ impl ContactStates {
         direction_tol: f64,
     ) {
         for &i in changed {
-            // With the Coulomb fixed point the slip directions and bounds settle together,
-            // linearly: their changes count as switches only after SETTLING_ITERATIONS, a
-            // change of state always. A contact that does not settle is then held like a
-            // chattering one.
-            let counts = if self.bound_fixed_point {
-                trials[i].state != self.states[i] || iteration > SETTLING_ITERATIONS
-            } else {
-                self.switched(i, &trials[i], pairs[i].penalty_tangent, direction_tol)
-            };
+            // A change of state always counts as a switch, and after SETTLING_ITERATIONS every
+            // change does: a contact that does not settle is then held like a chattering one.
+            // Before, with the Coulomb fixed point the slip directions and bounds settle
+            // together, linearly, so their changes do not count; without it a change of slip
+            // direction counts (a sliding force that is off the bound does not).
+            let counts = trials[i].state != self.states[i]
+                || iteration > SETTLING_ITERATIONS
+                || (!self.bound_fixed_point
+                    && self.switched(i, &trials[i], pairs[i].penalty_tangent, direction_tol));
             if counts {
                 self.switches[i] += 1;
             }
@@ -137,6 +137,8 @@ impl ContactStates {
             if t.state == ContactState::Slip && self.states[i] == ContactState::Slip {
                 self.directions[i] = t.direction;
             }
+            // A held contact slides along its held direction without the spring: the force
+            // it is assembled with is then the one `hold` gives it.
             self.perpendicular[i] = if t.state == ContactState::Slip && t.trial_norm > 0.0 {
                 (
                     pairs[i].penalty_tangent * t.bound / t.trial_norm,
