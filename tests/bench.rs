@@ -64,7 +64,24 @@ fn the_small_cell_runs_every_stage() {
     assert!(curve.factorizations >= 1);
     assert_eq!((curve.completed, curve.steps), (1, 2));
     assert!(curve.projected_total > curve.total, "{curve:?}");
+    // The default curve is the generated cell as it is, to 1 %; the mild Tresca curve of
+    // earlier reports follows it.
+    assert_eq!((curve.name.as_str(), curve.strain), ("default", 0.01));
+    assert!(
+        curve.physics.starts_with("Coulomb μ = 0.3"),
+        "{}",
+        curve.physics
+    );
+    let mild = c.mild_curve.as_ref().expect("mild curve ran");
+    assert_eq!(
+        (mild.name.as_str(), mild.strain, mild.error.as_deref()),
+        ("mild", 2e-3, None)
+    );
+    assert!(mild.physics.starts_with("Tresca"), "{}", mild.physics);
+    assert!(curve.max_equilibrium_residual <= 1e-8, "{curve:?}");
     let text = markdown(&r);
+    assert!(text.contains("| mild curve: increments, total"), "{text}");
+    assert!(text.contains("| curve: low rank: largest order"), "{text}");
     assert!(text.contains("| six cell problems"));
     assert!(text.contains("1 of 2 in"), "{text}");
     let command = reproduce_command(&r);

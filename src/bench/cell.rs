@@ -203,11 +203,19 @@ fn updown_solver(
 /// The incremental elasto-plastic curve.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CurveBench {
+    /// Which curve: "default" (the generated cell as it is, Coulomb friction with the bond's
+    /// cohesion, no option) or "mild" (Tresca, bonded, stabilized: the curve of earlier
+    /// reports, kept for continuity).
+    #[serde(default = "mild_name")]
+    pub name: String,
+    /// The friction law and options it ran with.
+    #[serde(default)]
+    pub physics: String,
     /// Increments.
     pub steps: usize,
-    /// Macroscopic strain ε11 at the end.
+    /// Macroscopic ε11 at the end.
     pub strain: f64,
-    /// Tresca bound of the contacts (N).
+    /// Tresca bound of the contacts (N); 0 for the default curve.
     pub tresca_bound: f64,
     /// Increments done: fewer than `steps` when the time limit stopped the curve.
     pub completed: usize,
@@ -230,10 +238,26 @@ pub struct CurveBench {
     /// Residual correction steps of those solves (absent in reports written before).
     #[serde(default)]
     pub correction_steps: usize,
+    /// Largest capacitance order of a low-rank solve (columns of the correction in play).
+    #[serde(default)]
+    pub low_rank_largest_order: usize,
+    /// Most columns of U kept on one reference factorization.
+    #[serde(default)]
+    pub low_rank_most_columns: usize,
+    /// The capacitance order at which a low-rank solve is predicted to cost a factorization
+    /// (from the run's measured times, at its end); larger corrections refactorize.
+    #[serde(default)]
+    pub crossover_order: Option<usize>,
     /// Contacts sliding at the end.
     pub sliding_at_end: usize,
     /// Contacts held after chattering (summed over increments).
     pub held: usize,
+    /// Largest equilibrium residual ‖R‖/‖F‖ of an increment.
+    #[serde(default)]
+    pub max_equilibrium_residual: f64,
+    /// Work of the stabilizing springs as a share of the dissipated energy at the end.
+    #[serde(default)]
+    pub stabilization_share: f64,
     /// Seconds of the completed increments per stage: assemble, factorize, factor reuse,
     /// solve, classify, commit ([`crate::solve::IncrementTimings::NAMES`]); absent in reports
     /// written before it was measured.
@@ -241,6 +265,20 @@ pub struct CurveBench {
     pub stages: Option<[f64; 6]>,
     /// The error, when the curve failed.
     pub error: Option<String>,
+}
+
+fn mild_name() -> String {
+    "mild".into()
+}
+
+/// Which curve to run: name, the friction to impose (None: the model's own), bonded,
+/// stabilization, and the ε11 reached.
+struct CurveCase {
+    name: &'static str,
+    tresca_bound: Option<f64>,
+    bonded: bool,
+    stabilization: f64,
+    strain: f64,
 }
 
 /// Every stage of one cell.
@@ -289,8 +327,11 @@ pub struct CellBench {
     pub six_cell_problems: f64,
     /// Their stages (of the median run).
     pub six_cell_problem_stages: crate::homogenize::HomogenizeTimings,
-    /// The elasto-plastic curve (None when skipped).
+    /// The default elasto-plastic curve (None when skipped).
     pub curve: Option<CurveBench>,
+    /// The mild-strain Tresca curve of earlier reports (None when skipped).
+    #[serde(default)]
+    pub mild_curve: Option<CurveBench>,
     /// Peak resident memory of the process after this cell (bytes).
     pub peak_memory: Option<u64>,
 }
@@ -551,22 +592,35 @@ fn bench_reuse(
 
 fn bench_curve(
     model_desc: &crate::model::ModelDescription,
+    case: &CurveCase,
     opts: &BenchOptions,
 ) -> Result<CurveBench, Error> {
     let mut desc = model_desc.clone();
-    if let Some(c) = desc.contact.as_mut() {
-        c.friction = FrictionSpec::Tresca {
-            bound: opts.tresca_bound,
-        };
+    let mut physics = match desc.contact.as_ref().map(|c| &c.friction) {
+        Some(FrictionSpec::Coulomb { mu, cohesion }) => {
+            format!("Coulomb μ = {mu}, cohesion {cohesion:.3e} N")
+        }
+        Some(f) => format!("{f:?}"),
+        None => "no contact".into(),
+    };
+    if let (Some(bound), Some(c)) = (case.tresca_bound, desc.contact.as_mut()) {
+        c.friction = FrictionSpec::Tresca { bound };
+        physics = format!("Tresca {bound:e} N");
+    }
+    if case.bonded {
+        physics += ", --bonded";
+    }
+    if case.stabilization > 0.0 {
+        physics += &format!(", --stabilization {:e}", case.stabilization);
     }
     let model = Model::from_description(&desc)?;
     let curve_opts = CurveOptions {
-        strain: [opts.curve_strain, 0.0, 0.0, 0.0, 0.0, 0.0],
+        strain: [case.strain, 0.0, 0.0, 0.0, 0.0, 0.0],
         steps: opts.curve_steps,
         unload: false,
         incremental: IncrementalOptions {
-            bonded: true,
-            stabilization: 1e-8,
+            bonded: case.bonded,
+            stabilization: case.stabilization,
             deadline: opts
                 .curve_time_limit
                 .map(|s| Instant::now() + std::time::Duration::from_secs_f64(s)),
@@ -577,9 +631,11 @@ fn bench_curve(
     let result = elasto_plastic_curve(&model, &curve_opts);
     let total = t.elapsed().as_secs_f64();
     let mut bench = CurveBench {
+        name: case.name.into(),
+        physics,
         steps: opts.curve_steps,
-        strain: opts.curve_strain,
-        tresca_bound: opts.tresca_bound,
+        strain: case.strain,
+        tresca_bound: case.tresca_bound.unwrap_or(0.0),
         completed: 0,
         total,
         projected_total: total,
@@ -589,36 +645,61 @@ fn bench_curve(
         factorizations: 0,
         factor_reuses: 0,
         correction_steps: 0,
+        low_rank_largest_order: 0,
+        low_rank_most_columns: 0,
+        crossover_order: None,
         sliding_at_end: 0,
         held: 0,
+        max_equilibrium_residual: 0.0,
+        stabilization_share: 0.0,
         stages: None,
         error: None,
     };
     match result {
-        Ok(c) => {
-            let inc = &c.solution.increments;
-            let secs: Vec<f64> = inc.iter().map(|r| r.seconds).collect();
-            let spent: f64 = secs.iter().sum();
-            bench.completed = inc.len();
-            if !inc.is_empty() {
-                bench.projected_total =
-                    total - spent + spent / inc.len() as f64 * opts.curve_steps as f64;
-            }
-            bench.increment_max = secs.iter().copied().fold(0.0, f64::max);
-            bench.increment_median = median(secs);
-            bench.state_iterations = inc.iter().map(|r| r.iterations).sum();
-            bench.factorizations = inc.iter().map(|r| r.factorizations).sum();
-            bench.factor_reuses = inc.iter().map(|r| r.factor_reuses).sum();
-            bench.correction_steps = inc.iter().map(|r| r.reuse_iterations).sum();
-            bench.held = inc.iter().map(|r| r.held).sum();
-            let mut stages = crate::solve::IncrementTimings::default();
-            inc.iter().for_each(|r| stages.add(&r.timings));
-            bench.stages = Some(stages.stages());
-            bench.sliding_at_end = inc.last().map_or(0, |r| r.slip);
-        }
+        Ok(c) => record_curve(&mut bench, &c, opts.curve_steps),
         Err(e) => bench.error = Some(e.to_string()),
     }
     Ok(bench)
+}
+
+/// Fills `bench` from the curve `c` of `steps` increments.
+fn record_curve(bench: &mut CurveBench, c: &crate::homogenize::Curve, steps: usize) {
+    let inc = &c.solution.increments;
+    let secs: Vec<f64> = inc.iter().map(|r| r.seconds).collect();
+    let spent: f64 = secs.iter().sum();
+    bench.completed = inc.len();
+    if !inc.is_empty() {
+        bench.projected_total = bench.total - spent + spent / inc.len() as f64 * steps as f64;
+    }
+    bench.increment_max = secs.iter().copied().fold(0.0, f64::max);
+    bench.increment_median = median(secs);
+    bench.state_iterations = inc.iter().map(|r| r.iterations).sum();
+    bench.factorizations = inc.iter().map(|r| r.factorizations).sum();
+    bench.factor_reuses = inc.iter().map(|r| r.factor_reuses).sum();
+    bench.correction_steps = inc.iter().map(|r| r.reuse_iterations).sum();
+    bench.low_rank_largest_order = inc
+        .iter()
+        .map(|r| r.low_rank.largest_order)
+        .max()
+        .unwrap_or(0);
+    bench.low_rank_most_columns = inc.iter().map(|r| r.low_rank.columns).max().unwrap_or(0);
+    bench.crossover_order = inc.last().and_then(|r| r.low_rank.crossover_order);
+    bench.held = inc.iter().map(|r| r.held).sum();
+    bench.max_equilibrium_residual = inc
+        .iter()
+        .map(|r| r.equilibrium_residual)
+        .fold(0.0, f64::max);
+    bench.stabilization_share = inc.last().map_or(0.0, |r| {
+        if r.dissipated > 0.0 {
+            r.energy.stabilization.abs() / r.dissipated
+        } else {
+            0.0
+        }
+    });
+    let mut stages = crate::solve::IncrementTimings::default();
+    inc.iter().for_each(|r| stages.add(&r.timings));
+    bench.stages = Some(stages.stages());
+    bench.sliding_at_end = inc.last().map_or(0, |r| r.slip);
 }
 
 /// Runs every stage on the preset `cell`.
@@ -693,12 +774,31 @@ pub fn bench_cell(
     let (six, homogenized) = median_of(opts.repeats, || {
         homogenize_elastic(&model, &SolveOptions::default())
     })?;
-    let curve = if opts.curve_steps > 0 {
-        log(&format!("{cell}: {}-increment curve", opts.curve_steps));
-        Some(bench_curve(&generated.description, opts)?)
-    } else {
-        None
+    let default_case = CurveCase {
+        name: "default",
+        tresca_bound: None,
+        bonded: false,
+        stabilization: 0.0,
+        strain: opts.curve_strain,
     };
+    let mild_case = CurveCase {
+        name: "mild",
+        tresca_bound: Some(opts.tresca_bound),
+        bonded: true,
+        stabilization: 1e-8,
+        strain: opts.mild_curve_strain,
+    };
+    let mut curves = [default_case, mild_case].map(|case| {
+        (opts.curve_steps > 0 && case.strain != 0.0).then(|| {
+            log(&format!(
+                "{cell}: {}-increment {} curve",
+                opts.curve_steps, case.name
+            ));
+            bench_curve(&generated.description, &case, opts)
+        })
+    });
+    let mild_curve = curves[1].take().transpose()?;
+    let curve = curves[0].take().transpose()?;
     Ok(CellBench {
         cell: cell.to_string(),
         fibers: generated.report.deposited,
@@ -725,6 +825,7 @@ pub fn bench_cell(
         six_cell_problems: six,
         six_cell_problem_stages: homogenized.timings,
         curve,
+        mild_curve,
         peak_memory: peak_memory_bytes(),
     })
 }

@@ -29,14 +29,18 @@ pub struct BenchOptions {
     /// Repeats of each timed stage (the median is reported); the millisecond stages (contact
     /// search and set, value fills) run at least 15 times.
     pub repeats: usize,
-    /// Increments of the elasto-plastic curve (0: skip it).
+    /// Increments of each elasto-plastic curve (0: skip them).
     pub curve_steps: usize,
-    /// Macroscopic ε11 at the end of the curve.
+    /// Macroscopic ε11 at the end of the default curve: the generated cell as it is (Coulomb
+    /// friction with the bond's cohesion), no option (0: skip it).
     pub curve_strain: f64,
+    /// Macroscopic ε11 at the end of the mild curve of earlier reports: Tresca friction at
+    /// `tresca_bound`, bonded, stabilized by 1e-8 (0: skip it).
+    pub mild_curve_strain: f64,
     /// Wall-clock limit of one curve (s): it stops after the increment that passes it and the
     /// report projects the rest (None: no limit).
     pub curve_time_limit: Option<f64>,
-    /// Tresca bound of the contacts in the curve (N); the curve runs on bonded contacts (see
+    /// Tresca bound of the contacts in the mild curve (N), which runs on bonded contacts (see
     /// [`crate::solve::IncrementalOptions::bonded`]).
     pub tresca_bound: f64,
 }
@@ -48,7 +52,8 @@ impl Default for BenchOptions {
             seed: 1,
             repeats: 3,
             curve_steps: 100,
-            curve_strain: 2e-3,
+            curve_strain: 1e-2,
+            mild_curve_strain: 2e-3,
             tresca_bound: 1e-4,
             curve_time_limit: Some(DEFAULT_CURVE_TIME_LIMIT),
         }
@@ -79,6 +84,7 @@ pub fn run_bench(opts: &BenchOptions, log: &mut dyn FnMut(&str)) -> Result<Bench
         return Err(Error::InvalidOption("repeats must be at least 1".into()));
     }
     if !(opts.curve_strain.is_finite()
+        && opts.mild_curve_strain.is_finite()
         && opts.tresca_bound.is_finite()
         && opts.tresca_bound >= 0.0
         && opts
@@ -86,7 +92,7 @@ pub fn run_bench(opts: &BenchOptions, log: &mut dyn FnMut(&str)) -> Result<Bench
             .is_none_or(|s| s.is_finite() && s > 0.0))
     {
         return Err(Error::InvalidOption(
-            "curve strain, Tresca bound and curve time limit must be finite, the bound ≥ 0, the limit > 0".into(),
+            "curve strains, Tresca bound and curve time limit must be finite, the bound ≥ 0, the limit > 0".into(),
         ));
     }
     for c in &opts.cells {

@@ -22,6 +22,14 @@ fn per_second(v: f64) -> String {
     format!("{:.2e}/s", v)
 }
 
+/// A table cell of the curve `pick` chooses: `f` of it, or a dash.
+fn curve_cell<'a>(
+    pick: fn(&super::CellBench) -> Option<&super::CurveBench>,
+    f: &'a dyn Fn(&super::CurveBench) -> String,
+) -> impl Fn(&super::CellBench) -> String + 'a {
+    move |c| pick(c).map_or("–".into(), f)
+}
+
 /// The whole report as Markdown.
 pub fn markdown(r: &BenchReport) -> String {
     let m = &r.machine;
@@ -102,51 +110,79 @@ pub fn markdown(r: &BenchReport) -> String {
                 .join(" / ")
         },
     );
-    row("curve: increments, total", &|c| {
-        c.curve.as_ref().map_or("–".into(), |k| match &k.error {
-            Some(e) => format!("failed: {e}"),
-            None if k.completed < k.steps => format!(
-                "{} of {} in {} (time limit), projected {}",
-                k.completed,
-                k.steps,
-                ms(k.total),
-                ms(k.projected_total)
+    type Pick = fn(&super::CellBench) -> Option<&super::CurveBench>;
+    let curves: [(&str, Pick); 2] = [
+        ("curve", |c| c.curve.as_ref()),
+        ("mild curve", |c| c.mild_curve.as_ref()),
+    ];
+    for (label, pick) in curves {
+        if !r.cells.iter().any(|c| pick(c).is_some()) {
+            continue;
+        }
+        row(
+            &format!("{label}: physics, ε11 at the end"),
+            &curve_cell(pick, &|k| format!("{}; {}", k.physics, k.strain)),
+        );
+        row(
+            &format!("{label}: increments, total"),
+            &curve_cell(pick, &|k| match &k.error {
+                Some(e) => format!("failed: {e}"),
+                None if k.completed < k.steps => format!(
+                    "{} of {} in {} (time limit), projected {}",
+                    k.completed,
+                    k.steps,
+                    ms(k.total),
+                    ms(k.projected_total)
+                ),
+                None => format!("{}, {}", k.steps, ms(k.total)),
+            }),
+        );
+        row(
+            &format!("{label}: one increment (median / max)"),
+            &curve_cell(pick, &|k| {
+                format!("{} / {}", ms(k.increment_median), ms(k.increment_max))
+            }),
+        );
+        row(
+            &format!(
+                "{label}: state iterations / factorizations / low-rank solves (correction steps)"
             ),
-            None => format!("{}, {}", k.steps, ms(k.total)),
-        })
-    });
-    row("curve: one increment (median / max)", &|c| {
-        c.curve.as_ref().map_or("–".into(), |k| {
-            format!("{} / {}", ms(k.increment_median), ms(k.increment_max))
-        })
-    });
-    row(
-        "curve: state iterations / factorizations / low-rank solves (correction steps)",
-        &|c| {
-            c.curve.as_ref().map_or("–".into(), |k| {
+            &curve_cell(pick, &|k| {
                 format!(
                     "{} / {} / {} ({})",
                     k.state_iterations, k.factorizations, k.factor_reuses, k.correction_steps
                 )
-            })
-        },
-    );
-    row(
-        &format!("… {}", crate::solve::IncrementTimings::NAMES.join(" / ")),
-        &|c| {
-            c.curve
-                .as_ref()
-                .and_then(|k| k.stages)
-                .map_or("–".into(), |s| {
+            }),
+        );
+        row(
+            &format!("{label}: low rank: largest order / most columns / crossover order"),
+            &curve_cell(pick, &|k| {
+                format!(
+                    "{} / {} / {}",
+                    k.low_rank_largest_order,
+                    k.low_rank_most_columns,
+                    opt(k.crossover_order)
+                )
+            }),
+        );
+        row(
+            &format!("… {}", crate::solve::IncrementTimings::NAMES.join(" / ")),
+            &curve_cell(pick, &|k| {
+                k.stages.map_or("–".into(), |s| {
                     s.iter().map(|&t| ms(t)).collect::<Vec<_>>().join(" / ")
                 })
-        },
-    );
-    row("curve: sliding at end / held", &|c| {
-        c.curve.as_ref().map_or("–".into(), |k| {
-            format!("{} / {}", k.sliding_at_end, k.held)
-        })
-    });
+            }),
+        );
+        row(
+            &format!("{label}: sliding at end / held / max residual / stabilization work"),
+            &curve_cell(pick, &|k| {
+                format!(
+                    "{} / {} / {:.1e} / {:.1e} of dissipation",
+                    k.sliding_at_end, k.held, k.max_equilibrium_residual, k.stabilization_share
+                )
+            }),
+        );
+    }
     row("peak memory", &|c| {
         opt(c.peak_memory.map(|b| format!("{:.2} GB", b as f64 / 1e9)))
     });
