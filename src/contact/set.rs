@@ -431,6 +431,12 @@ impl ContactSet {
             let penalty_rotation = pr
                 .or(settings.penalty_rotation)
                 .unwrap_or_else(|| rotation_penalty_of_elements(model, &elements, penalty_normal));
+            let scale = settings.penalty_scale;
+            let (penalty_normal, penalty_tangent, penalty_rotation) = (
+                scale * penalty_normal,
+                scale * penalty_tangent,
+                scale * penalty_rotation,
+            );
             let mut gap = gap;
             if gap < 0.0 {
                 set.penetration.count += 1;

@@ -17,6 +17,8 @@ pub struct ContactSettings {
     pub penalty_tangent: Option<f64>,
     /// Rolling resistance (N·m/rad), or automatic.
     pub penalty_rotation: Option<f64>,
+    /// Factor on every contact's penalties, default or given.
+    pub penalty_scale: f64,
     /// Friction law.
     pub friction: Friction,
     /// Initially penetrating pairs.
@@ -80,6 +82,7 @@ pub(super) fn check_settings(
     check_penalty(item, "penalty_normal", spec.penalty_normal)?;
     check_penalty(item, "penalty_tangent", spec.penalty_tangent)?;
     check_rotation_penalty(item, spec.penalty_rotation)?;
+    check_penalty(item, "penalty_scale", spec.penalty_scale)?;
     let tolerance = spec.tolerance.unwrap_or(max_radius);
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(invalid(
@@ -120,6 +123,7 @@ pub(super) fn check_settings(
         penalty_normal: spec.penalty_normal,
         penalty_tangent: spec.penalty_tangent,
         penalty_rotation: spec.penalty_rotation,
+        penalty_scale: spec.penalty_scale.unwrap_or(1.0),
         friction,
         initial_penetration: spec.initial_penetration.unwrap_or(PenetrationSpec::Adjust),
         bonded: spec.bonded,

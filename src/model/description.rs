@@ -127,6 +127,10 @@ pub struct ContactSpec {
     /// point contact); default p_N a²/4 with a half the smaller fiber radius.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub penalty_rotation: Option<f64>,
+    /// Factor s > 0 on every contact's penalties p_N, p_T and p_R, default or given (default
+    /// 1): a penalty study (s = 1, 10, 100 …) keeps each contact's share of the defaults.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty_scale: Option<f64>,
     /// Friction law.
     #[serde(default)]
     pub friction: FrictionSpec,
