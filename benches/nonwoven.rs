@@ -51,7 +51,7 @@ fn stages(c: &mut Criterion) {
 
         let stick = sys.assemble(&model);
         let a = sys.pattern.matrix(&stick.values).expect("matrix");
-        let rhs: Vec<f64> = stick.coupling.iter().map(|c| -c[0]).collect();
+        let rhs: Vec<f64> = stick.couplings.coupling.iter().map(|c| -c[0]).collect();
         g.throughput(Throughput::Elements(1));
         let mut kinds = vec![("faer", SolverKind::FaerCholesky)];
         if cfg!(feature = "cholmod") {

@@ -167,8 +167,9 @@ fn capacitance_orders_above_the_bound_factorize_directly_and_change_nothing() {
 /// springs being far stiffer than the fibers); with ε springs on
 /// the open contacts it is K_ff + ε Σ K_open, whose Schur complement is stiffer, by a PSD
 /// matrix: every diagonal entry at least `elastic_abd`'s, and measurably larger at ε = 10⁻²
-/// (this is the path the run took). Without factor reuse there is no reference: the curve
-/// factorizes K_ff itself, exactly `elastic_abd`.
+/// (this is the path the run took). Without factor reuse the run's first factorization is the
+/// all-stick matrix as well, and the ABD is solved on it the same way (before, it fell back to
+/// a second set-up of the cell, exactly `elastic_abd`).
 #[test]
 fn the_elastic_abd_is_solved_on_the_runs_all_stick_factorization() {
     let mut desc = small_nonwoven();
@@ -203,7 +204,7 @@ fn the_elastic_abd_is_solved_on_the_runs_all_stick_factorization() {
     let plain = short(&|_| {});
     assert!(diff(&plain) <= 1e-8 * scale, "{}", diff(&plain) / scale);
     let own = short(&|o| o.reuse_factor = false);
-    assert_eq!(own, alone);
+    assert!(diff(&own) <= 1e-8 * scale, "{}", diff(&own) / scale);
     let stiffened = short(&|o| o.stabilization = 1e-2);
     for i in 0..6 {
         assert!(

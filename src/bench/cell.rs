@@ -746,7 +746,7 @@ pub fn bench_cell(
     let a = sys.pattern.matrix(&values.values)?;
     let n = sys.n_free();
     // The first cell problem's right-hand side, −K_fE e₁.
-    let rhs: Vec<f64> = values.coupling.iter().map(|c| -c[0]).collect();
+    let rhs: Vec<f64> = values.couplings.coupling.iter().map(|c| -c[0]).collect();
     let scattered = 144.0 * elements as f64 + 576.0 * sys.n_contacts() as f64;
     let fill_bytes = 8.0 * scattered;
     let mut backend_results = Vec::new();

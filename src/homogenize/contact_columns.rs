@@ -312,10 +312,10 @@ mod tests {
             for r in 0..m {
                 for c in 0..m {
                     match (is_driver(r), is_driver(c)) {
-                        (true, true) => out.k_ee[(r % 6, c % 6)] += k(r, c),
+                        (true, true) => out.couplings.k_ee[(r % 6, c % 6)] += k(r, c),
                         (false, true) => {
                             if let Some(f) = disc.reduced(6 * node(r) + r % 6) {
-                                out.coupling[f][c % 6] += k(r, c);
+                                out.couplings.coupling[f][c % 6] += k(r, c);
                             }
                         }
                         (_, false) => {
@@ -373,7 +373,13 @@ mod tests {
         for (k, (a, b)) in one.values.iter().zip(&expected.values).enumerate() {
             assert!(close(*a, *b), "K_ff slot {k}: {a} against {b}");
         }
-        for (f, (a, b)) in one.coupling.iter().zip(&expected.coupling).enumerate() {
+        for (f, (a, b)) in one
+            .couplings
+            .coupling
+            .iter()
+            .zip(&expected.couplings.coupling)
+            .enumerate()
+        {
             for e in 0..6 {
                 assert!(
                     close(a[e], b[e]),
@@ -383,13 +389,18 @@ mod tests {
                 );
             }
         }
-        assert!(expected.coupling.iter().flatten().any(|v| *v != 0.0));
-        assert!((one.k_ee - expected.k_ee).abs().max() <= 1e-12 * scale);
-        assert!(expected.k_ee.abs().max() > 0.0);
+        assert!(expected
+            .couplings
+            .coupling
+            .iter()
+            .flatten()
+            .any(|v| *v != 0.0));
+        assert!((one.couplings.k_ee - expected.couplings.k_ee).abs().max() <= 1e-12 * scale);
+        assert!(expected.couplings.k_ee.abs().max() > 0.0);
         // Sums in a fixed order: bit for bit the same on three threads.
         let three = in_pool(3, fill);
         assert_eq!(one.values, three.values);
-        assert_eq!(one.coupling, three.coupling);
-        assert_eq!(one.k_ee, three.k_ee);
+        assert_eq!(one.couplings.coupling, three.couplings.coupling);
+        assert_eq!(one.couplings.k_ee, three.couplings.k_ee);
     }
 }

@@ -4,12 +4,14 @@
 //! switch), the elastic/plastic split (5.5–5.6) and the dissipated energy.
 
 use super::elastic::abd_on_factor;
+use super::elastic_abd;
 use super::segments::{linear_pieces, segment_starting_at, Segment};
-use super::{elastic_abd, PeriodicSystem};
 use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
 use crate::model::Model;
-use crate::solve::{run_incremental, IncrementalOptions, IncrementalSolution, OnAllStick};
+use crate::solve::{
+    run_incremental, DriverCouplings, IncrementalOptions, IncrementalSolution, OnAllStick,
+};
 use crate::Error;
 use serde::Serialize;
 
@@ -121,16 +123,9 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             "the number of increments must be at least 1".into(),
         ));
     }
-    // The all-stick system's driver couplings K_fE and K_EE: with six solves on the run's first
-    // factorization, when that is the all-stick matrix (same free DOFs), they give the elastic
-    // ABD. K_ff's own values and pattern are not kept through the run.
-    let couplings = {
-        let sys = PeriodicSystem::new(model)?;
-        let mut vals = sys.assemble(model);
-        vals.values = Vec::new();
-        vals
-    };
-    let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, false)?;
+    // The cell is set up once: pairing, contacts, percolation through the closed contacts (the
+    // all-stick system must hold together) and the anchor.
+    let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, true)?;
     let disc = Discretization::periodic(model, &p, &opts.strain, anchor);
     let n = opts.steps;
     let mut path: Vec<f64> = (1..=n).map(|k| k as f64 / n as f64).collect();
@@ -146,11 +141,14 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
     let area = p.geometry.area();
     let mut from_reference = None;
     let locate = |e| disc.locate(model, e);
+    // The elastic ABD: six solves on the run's first factorization, the all-stick matrix,
+    // with the run's own couplings to the drivers.
     let mut on_all_stick = |solver: &mut dyn fibercell_solver::LinearSolver,
-                            a: fibercell_solver::CscRef<'_>| {
-        if a.nrows() == couplings.coupling.len() {
+                            a: fibercell_solver::CscRef<'_>,
+                            couplings: Option<&DriverCouplings>| {
+        if let Some(couplings) = couplings {
             let solve = &opts.incremental.solve;
-            from_reference = Some(abd_on_factor(&couplings, area, solver, a, solve, &locate)?);
+            from_reference = Some(abd_on_factor(couplings, area, solver, a, solve, &locate)?);
         }
         Ok(())
     };

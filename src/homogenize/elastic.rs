@@ -8,6 +8,7 @@ use super::pressure::{default_pixel, pressure_load};
 use super::{Orthotropic, PeriodicSystem, PeriodicValues, ThesisModuli};
 use crate::cell::{macro_matrix, CellGeometry};
 use crate::model::Model;
+use crate::solve::DriverCouplings;
 use crate::solve::{check_backward_error, SolveOptions};
 use crate::Error;
 use fibercell_solver::{solve_checked, CscRef, LinearSolver, SolverError};
@@ -147,12 +148,14 @@ fn factor_cell(
 
 /// ABD = (K_EE + K_Ef x) / |Y| from the driver couplings and the six cell-problem solutions
 /// x = −K_ff⁻¹ K_fE (columns of length `n`, stacked).
-fn abd_of(vals: &PeriodicValues, x: &[f64], n: usize, area: f64) -> [[f64; 6]; 6] {
+fn abd_of(couplings: &DriverCouplings, x: &[f64], n: usize, area: f64) -> [[f64; 6]; 6] {
     let mut abd = [[0.0; 6]; 6];
     for (j, row) in abd.iter_mut().enumerate() {
         for (k, v) in row.iter_mut().enumerate() {
-            let schur: f64 = (0..n).map(|i| vals.coupling[i][j] * x[k * n + i]).sum();
-            *v = (vals.k_ee[(j, k)] + schur) / area;
+            let schur: f64 = (0..n)
+                .map(|i| couplings.coupling[i][j] * x[k * n + i])
+                .sum();
+            *v = (couplings.k_ee[(j, k)] + schur) / area;
         }
     }
     abd
@@ -160,9 +163,9 @@ fn abd_of(vals: &PeriodicValues, x: &[f64], n: usize, area: f64) -> [[f64; 6]; 6
 
 /// The right-hand sides −K_fE e_k of the six cell problems, stacked, with room for `extra`
 /// more columns (zero).
-fn cell_rhs(vals: &PeriodicValues, n: usize, extra: usize) -> Vec<f64> {
+fn cell_rhs(couplings: &DriverCouplings, n: usize, extra: usize) -> Vec<f64> {
     let mut rhs = vec![0.0; (6 + extra) * n];
-    for (i, c) in vals.coupling.iter().enumerate() {
+    for (i, c) in couplings.coupling.iter().enumerate() {
         for k in 0..6 {
             rhs[k * n + i] = -c[k];
         }
@@ -201,7 +204,7 @@ pub fn cell_problem(model: &Model) -> Result<LinearSystem, Error> {
         .collect();
     Ok(LinearSystem {
         matrix,
-        rhs: cell_rhs(&vals, n, 0),
+        rhs: cell_rhs(&vals.couplings, n, 0),
         columns: 6,
         dofs,
     })
@@ -214,28 +217,28 @@ pub fn elastic_abd(model: &Model, options: &SolveOptions) -> Result<[[f64; 6]; 6
     let (sys, vals, mut solver) = factor_cell(model, options, &mut HomogenizeTimings::default())?;
     let a = sys.pattern.matrix(&vals.values)?;
     let area = sys.periodicity.geometry.area();
-    abd_on_factor(&vals, area, solver.as_mut(), a, options, &|e| {
+    abd_on_factor(&vals.couplings, area, solver.as_mut(), a, options, &|e| {
         sys.locate(model, e)
     })
 }
 
-/// The all-stick ABD from the six cell problems −K_fE e_k of `vals` (its couplings K_fE and
-/// K_EE; K_ff's values are not read) solved on `solver`, a factorization of `a`: K_ff itself,
-/// or a matrix on the same free DOFs that stands for it (the incremental run's reference, whose
-/// pattern also holds the open contacts). The backward error is checked against `a`.
+/// The all-stick ABD from the six cell problems −K_fE e_k of `couplings` (K_fE and K_EE)
+/// solved on `solver`, a factorization of `a`: K_ff itself, or a matrix on the same free DOFs
+/// that stands for it (the incremental run's all-stick matrix, whose pattern also holds the
+/// open contacts). The backward error is checked against `a`.
 pub(super) fn abd_on_factor(
-    vals: &PeriodicValues,
+    couplings: &DriverCouplings,
     area: f64,
     solver: &mut dyn LinearSolver,
     a: CscRef<'_>,
     options: &SolveOptions,
     locate: &dyn Fn(SolverError) -> Error,
 ) -> Result<[[f64; 6]; 6], Error> {
-    let n = vals.coupling.len();
-    let rhs = cell_rhs(vals, n, 0);
+    let n = couplings.coupling.len();
+    let rhs = cell_rhs(couplings, n, 0);
     let (x, report) = solve_checked(solver, a, &rhs, 6).map_err(locate)?;
     check_backward_error(options, report.backward_error, "cell problems")?;
-    Ok(abd_of(vals, &x, n, area))
+    Ok(abd_of(couplings, &x, n, area))
 }
 
 /// Solves the six unit cell problems of `model` (which needs a `[cell]`) and returns ABD and
@@ -253,7 +256,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
     let area = g.area();
     let disc = &sys.discretization;
     let driver = disc.driver().unwrap_or(usize::MAX);
-    let mut rhs = cell_rhs(&vals, n, 1);
+    let mut rhs = cell_rhs(&vals.couplings, n, 1);
     // The Θ load, moved onto the generalized DOFs (Tᵀ f, periodic images included), and its
     // virial Σ M(x)ᵀ f over the loaded points (images at their shifted positions).
     let load = pressure_load(model, &g, 1.0, default_pixel(model));
@@ -291,7 +294,9 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
     // Driver reaction (internal force minus the load on the drivers) plus the load virial: the
     // volume average of the stress, as (5.4) defines it.
     let b_hom: [f64; 6] = std::array::from_fn(|k| {
-        let reaction: f64 = (0..n).map(|i| vals.coupling[i][k] * theta[i]).sum();
+        let reaction: f64 = (0..n)
+            .map(|i| vals.couplings.coupling[i][k] * theta[i])
+            .sum();
         (reaction - driver_load[k] + virial[k]) / area
     });
     let pressure = PressureResponse {
@@ -300,7 +305,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
         pixel: load.pixel,
         displacements: sys.expand(theta, &[0.0; 6]),
     };
-    let abd = abd_of(&vals, &x, n, area);
+    let abd = abd_of(&vals.couplings, &x, n, area);
     let scale = abd.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     let asym = (0..6)
         .flat_map(|j| (0..6).map(move |k| (j, k)))

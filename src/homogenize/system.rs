@@ -12,6 +12,7 @@ use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStra
 use crate::constraints::Discretization;
 use crate::contact::{ContactPair, ContactSet, ContactSide};
 use crate::model::{Dof, Model};
+use crate::solve::DriverCouplings;
 use crate::Error;
 use fibercell_solver::{CscMatrix, SolverError};
 use nalgebra::{DMatrix, SMatrix};
@@ -22,10 +23,8 @@ use rayon::prelude::*;
 pub struct PeriodicValues {
     /// Values of K_ff on the pattern.
     pub values: Vec<f64>,
-    /// K_fE: for every free DOF, its coupling to the six drivers.
-    pub coupling: Vec<[f64; 6]>,
-    /// K_EE.
-    pub k_ee: SMatrix<f64, 6, 6>,
+    /// K_fE and K_EE.
+    pub couplings: DriverCouplings,
 }
 
 type Matrix6 = SMatrix<f64, 6, 6>;
@@ -321,8 +320,10 @@ impl PeriodicSystem {
     pub fn zero_values(&self) -> PeriodicValues {
         PeriodicValues {
             values: vec![0.0; self.pattern.nnz()],
-            coupling: vec![[0.0; 6]; self.discretization.n_free()],
-            k_ee: SMatrix::zeros(),
+            couplings: DriverCouplings {
+                coupling: vec![[0.0; 6]; self.discretization.n_free()],
+                k_ee: SMatrix::zeros(),
+            },
         }
     }
 
@@ -351,12 +352,12 @@ impl PeriodicSystem {
         out: &mut PeriodicValues,
         which: impl Fn(usize) -> ContactStiffness + Sync,
     ) {
-        out.k_ee += self.contact_columns.add(
+        out.couplings.k_ee += self.contact_columns.add(
             &self.contacts,
             &self.pattern,
             &self.discretization,
             &mut out.values,
-            &mut out.coupling,
+            &mut out.couplings.coupling,
             |i| self.contacts[i].jump_stiffness(which(i) == ContactStiffness::Stick),
         );
     }
@@ -373,7 +374,7 @@ impl PeriodicSystem {
             disc: &self.discretization,
             driver: self.discretization.driver().unwrap_or(usize::MAX),
             values: SharedMut::new(&mut out.values),
-            coupling: SharedMut::new(&mut out.coupling),
+            coupling: SharedMut::new(&mut out.couplings.coupling),
         };
         for color in colors {
             let driver_blocks: Vec<Option<Matrix6>> = color
@@ -382,7 +383,7 @@ impl PeriodicSystem {
                 .map(|&i| block(i, &sink))
                 .collect();
             for m in driver_blocks.into_iter().flatten() {
-                out.k_ee += m;
+                out.couplings.k_ee += m;
             }
         }
     }

@@ -17,8 +17,9 @@ pub use connectivity::{check_supported, check_supported_with};
 pub use increment_timings::IncrementTimings;
 pub(crate) use incremental::{run_incremental, OnAllStick};
 pub use incremental::{
-    solve_incremental, ContactRecord, EnergyBalance, IncrementRecord, IncrementalOptions,
-    IncrementalSolution, LowRankSizes, Progress, BOUND_TOLERANCE, MAX_LOW_RANK_COLUMNS,
+    solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
+    IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, BOUND_TOLERANCE,
+    MAX_LOW_RANK_COLUMNS,
 };
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
 pub use matrix_solve::{solve_matrix, MatrixSolveReport};

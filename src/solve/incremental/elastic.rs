@@ -81,7 +81,7 @@ impl Elastic {
     }
 
     /// Tᵀ K T of element e on its generalized nodes.
-    fn matrix(&self, model: &Model, e: usize) -> DMatrix<f64> {
+    pub(super) fn matrix(&self, model: &Model, e: usize) -> DMatrix<f64> {
         let k = element_stiffness(model, e);
         let k = DMatrix::from_fn(12, 12, |r, c| k[(r, c)]);
         match &self.maps[e] {

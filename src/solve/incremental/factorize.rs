@@ -4,6 +4,7 @@
 
 use super::assemble::System;
 use super::contact_states::ContactStates;
+use super::driver_couplings::DriverCouplings;
 use super::factors::ReferenceBlock;
 use super::increment::Increment;
 use super::StickSlip;
@@ -93,18 +94,20 @@ impl StickSlip<'_, '_> {
                 matrix.changed_since_reference = Some(Vec::new());
                 factors.low_rank.reset();
                 factors.affine.clear();
-                // The initial states are all-stick unless frictionless (sliding).
+            }
+            // The initial states are all-stick unless frictionless (sliding).
+            let friction = setup.friction();
+            if !nonsymmetric
+                && friction != Friction::None
+                && contacts
+                    .states
+                    .iter()
+                    .zip(&setup.pairs)
+                    .all(|(s, p)| *s == ContactStates::initial(p, friction))
+            {
                 if let Some(hook) = factors.on_all_stick.take() {
-                    let friction = setup.friction();
-                    if friction != Friction::None
-                        && contacts
-                            .states
-                            .iter()
-                            .zip(&setup.pairs)
-                            .all(|(s, p)| *s == ContactStates::initial(p, friction))
-                    {
-                        hook(solver.as_mut(), a)?;
-                    }
+                    let couplings = DriverCouplings::of(setup, contacts);
+                    hook(solver.as_mut(), a, couplings.as_ref())?;
                 }
             }
             inc.lap(|t| &mut t.factorize);

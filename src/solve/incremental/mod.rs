@@ -26,6 +26,7 @@ mod assemble;
 mod classify;
 mod commit;
 mod contact_states;
+mod driver_couplings;
 mod elastic;
 mod factor_reuse;
 mod factorize;
@@ -38,6 +39,7 @@ mod return_mapping;
 mod setup;
 mod stabilizer;
 
+pub use driver_couplings::DriverCouplings;
 pub use options::{IncrementalOptions, Progress, BOUND_TOLERANCE, MAX_LOW_RANK_COLUMNS};
 pub use records::{
     ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
@@ -73,12 +75,16 @@ pub fn solve_incremental(
     run_incremental(model, &Discretization::supported(model), set, opts, None)
 }
 
-/// Called once with the run's first reference factorization when that is the all-stick matrix
+/// Called once with the run's first symmetric factorization when that is the all-stick matrix
 /// (every closed contact in stick, every other open; open contacts carry their stabilizing
-/// springs when [`IncrementalOptions::stabilization`] > 0): the factorized solver and the
-/// matrix. The elasto-plastic curve solves its six elastic cell problems on it.
-pub(crate) type OnAllStick<'h> =
-    &'h mut dyn FnMut(&mut dyn LinearSolver, CscRef<'_>) -> Result<(), Error>;
+/// springs when [`IncrementalOptions::stabilization`] > 0): the factorized solver, the matrix
+/// and, for a periodic cell, its couplings to the drivers in the same states. The
+/// elasto-plastic curve solves its six elastic cell problems on it.
+pub(crate) type OnAllStick<'h> = &'h mut dyn FnMut(
+    &mut dyn LinearSolver,
+    CscRef<'_>,
+    Option<&DriverCouplings>,
+) -> Result<(), Error>;
 
 /// The incremental analysis on any discretization (supported structure or periodic cell).
 pub(crate) fn run_incremental(
