@@ -2,15 +2,16 @@
 //! value fills (serial and parallel), in elements per second.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use fibercell::assembly::{Assembler, DofMap, FillMode, Pattern};
+use fibercell::assembly::{Assembler, FillMode, Pattern};
+use fibercell::constraints::Discretization;
 use std::hint::black_box;
 use std::path::Path;
 
 fn assembly(c: &mut Criterion) {
     let model = fibercell::io::load_model(Path::new("fixtures/ok_grid30.json")).expect("fixture");
     let n_el = model.elements().len() as u64;
-    let dofs = DofMap::new(&model);
-    let pattern = Pattern::new(&model, &dofs).expect("pattern");
+    let dofs = Discretization::supported(&model);
+    let pattern = Pattern::new(&model, dofs.reduced_indices(), dofs.n_free()).expect("pattern");
     let assembler = Assembler::new(&model);
     let mut values = vec![0.0; pattern.nnz()];
     let mut g = c.benchmark_group("assembly/grid30");
@@ -18,8 +19,8 @@ fn assembly(c: &mut Criterion) {
     g.sample_size(20);
     g.bench_function("pattern", |b| {
         b.iter(|| {
-            let d = DofMap::new(black_box(&model));
-            let p = Pattern::new(&model, &d).expect("pattern");
+            let d = Discretization::supported(black_box(&model));
+            let p = Pattern::new(&model, d.reduced_indices(), d.n_free()).expect("pattern");
             let a = Assembler::new(&model);
             black_box((p.nnz(), a.n_colors()))
         })

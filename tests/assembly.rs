@@ -3,14 +3,15 @@
 
 mod common;
 use common::*;
-use fibercell::assembly::{element_stiffness, Assembler, DofMap, FillMode, Pattern};
+use fibercell::assembly::{element_stiffness, Assembler, FillMode, Pattern};
+use fibercell::constraints::Discretization;
 use fibercell::model::ModelDescription;
 use nalgebra::{DMatrix, Rotation3, Vector3};
 
-fn assemble(d: &ModelDescription, mode: FillMode) -> (DofMap, Pattern, Vec<f64>) {
+fn assemble(d: &ModelDescription, mode: FillMode) -> (Discretization, Pattern, Vec<f64>) {
     let model = build(d);
-    let dofs = DofMap::new(&model);
-    let pattern = Pattern::new(&model, &dofs).unwrap();
+    let dofs = Discretization::supported(&model);
+    let pattern = Pattern::new(&model, dofs.reduced_indices(), dofs.n_free()).unwrap();
     let mut values = vec![f64::NAN; pattern.nnz()];
     Assembler::new(&model)
         .fill(&model, &pattern, &mut values, mode)

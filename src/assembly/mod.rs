@@ -1,14 +1,12 @@
-//! From the model to the reduced sparse system: DOF numbering, the sparsity pattern with its
+//! From the model to the reduced sparse system: the sparsity pattern with its
 //! slot map (built once), and the value fill (serial or parallel, refilled in place).
 
 mod coloring;
-mod dof_map;
 mod fill;
 mod pattern;
 mod shared;
 
 pub use coloring::{color_blocks, color_elements};
-pub use dof_map::{block_starts, DofMap};
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
 pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};
 pub(crate) use shared::{prefetch, SharedMut};

@@ -3,7 +3,6 @@
 //! as the 24×24 contact blocks coupling four nodes (thesis 4.69–4.70) — to its place in the value
 //! array. Built once per set of blocks, so value fills never search or sort.
 
-use super::DofMap;
 use crate::model::Model;
 use fibercell_solver::{CscRef, SolverError};
 
@@ -31,30 +30,16 @@ pub struct Pattern {
 pub struct PatternTooLargeError(pub usize);
 
 impl Pattern {
-    /// The pattern of the frame elements of `model`.
-    pub fn new(model: &Model, dofs: &DofMap) -> Result<Self, PatternTooLargeError> {
-        Self::with_blocks(model, dofs, &[])
-    }
-
-    /// The pattern of the frame elements (blocks 0..n_elements) and of `extra` node blocks
-    /// (blocks n_elements.., e.g. contact pairs), each a list of distinct node indices.
-    pub fn with_blocks(
+    /// The pattern of the frame elements of `model` over the numbering `reduced` of `n_free`
+    /// unknowns (`Discretization::reduced_indices`, `Discretization::n_free`).
+    pub fn new(
         model: &Model,
-        dofs: &DofMap,
-        extra: &[Vec<usize>],
+        reduced: &[usize],
+        n_free: usize,
     ) -> Result<Self, PatternTooLargeError> {
         let elements: Vec<[usize; 2]> = model.elements().iter().map(|e| e.nodes).collect();
-        let blocks: Vec<&[usize]> = elements
-            .iter()
-            .map(|e| &e[..])
-            .chain(extra.iter().map(|b| &b[..]))
-            .collect();
-        Self::from_blocks(
-            dofs.reduced_indices(),
-            dofs.n_free(),
-            &blocks,
-            elements.len(),
-        )
+        let blocks: Vec<&[usize]> = elements.iter().map(|e| &e[..]).collect();
+        Self::from_blocks(reduced, n_free, &blocks, elements.len())
     }
 
     /// The pattern of arbitrary node blocks over a numbering `reduced` (6 entries per node: the

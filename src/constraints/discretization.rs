@@ -104,6 +104,18 @@ impl Discretization {
     pub fn n_free(&self) -> usize {
         self.free.len()
     }
+    /// Number of generalized DOFs (6 per generalized node).
+    pub fn n_global(&self) -> usize {
+        6 * self.n_gnodes
+    }
+    /// The generalized DOF of (node, dof): 6 · node + dof.
+    pub fn global(node: usize, dof: Dof) -> usize {
+        6 * node + dof.index()
+    }
+    /// Whether any prescribed value is non-zero.
+    pub fn has_nonzero_prescribed(&self) -> bool {
+        self.prescribed.iter().any(|v| *v != 0.0)
+    }
     /// Number of generalized nodes (physical nodes, plus the driver node of a cell).
     pub fn n_gnodes(&self) -> usize {
         self.n_gnodes
@@ -140,7 +152,7 @@ impl Discretization {
     }
     /// First unknown of every generalized node that has unknowns (block-Jacobi blocks).
     pub fn node_block_starts(&self) -> Vec<usize> {
-        crate::assembly::block_starts(self.free.iter().map(|&(node, _)| node))
+        block_starts(self.free.iter().map(|&(node, _)| node))
     }
 
     /// The generalized nodes of a block of physical nodes and T (6·nodes × 6·gnodes) with
@@ -267,4 +279,18 @@ impl Discretization {
             ..pair.clone()
         }
     }
+}
+
+/// Positions where the node of consecutive unknowns changes: the first unknown of every node
+/// block (block-Jacobi preconditioner blocks).
+fn block_starts(nodes: impl Iterator<Item = usize>) -> Vec<usize> {
+    let mut starts = Vec::new();
+    let mut last = usize::MAX;
+    for (k, node) in nodes.enumerate() {
+        if node != last {
+            starts.push(k);
+            last = node;
+        }
+    }
+    starts
 }

@@ -4,7 +4,8 @@
 //! matrix K_ff is a principal submatrix of the symmetric K and stays symmetric. Reactions are
 //! R_c = (K u)_c − F_c.
 
-use crate::assembly::{element_stiffness, DofMap};
+use super::Discretization;
+use crate::assembly::element_stiffness;
 use crate::model::{Dof, Model};
 use rayon::prelude::*;
 
@@ -23,7 +24,7 @@ pub struct Reaction {
 fn global_loads(model: &Model) -> Vec<f64> {
     let mut f = vec![0.0; 6 * model.nodes.len()];
     for l in &model.loads {
-        f[DofMap::global(l.node, l.dof)] += l.value;
+        f[Discretization::global(l.node, l.dof)] += l.value;
     }
     f
 }
@@ -58,7 +59,7 @@ pub fn internal_forces(model: &Model, u: &[f64]) -> Vec<f64> {
 }
 
 /// The reduced right-hand side F_f − K_fc u_c.
-pub fn reduced_rhs(model: &Model, dofs: &DofMap) -> Vec<f64> {
+pub fn reduced_rhs(model: &Model, dofs: &Discretization) -> Vec<f64> {
     let f = global_loads(model);
     let mut rhs = vec![0.0; dofs.n_free()];
     for (g, v) in f.iter().enumerate() {
@@ -88,14 +89,14 @@ pub fn reduced_rhs(model: &Model, dofs: &DofMap) -> Vec<f64> {
 }
 
 /// Reactions R_c = (K u)_c − F_c at every prescribed DOF, for the full solution `u`.
-pub fn reactions(model: &Model, dofs: &DofMap, u: &[f64]) -> Vec<Reaction> {
+pub fn reactions(model: &Model, dofs: &Discretization, u: &[f64]) -> Vec<Reaction> {
     let ku = internal_forces(model, u);
     let f = global_loads(model);
     model
         .supports
         .iter()
         .map(|s| {
-            let g = DofMap::global(s.node, s.dof);
+            let g = Discretization::global(s.node, s.dof);
             debug_assert!(dofs.reduced(g).is_none());
             Reaction {
                 node: s.node,

@@ -1,7 +1,7 @@
 //! The assembled reduced system K_ff u_f = F_f − K_fc u_c.
 
-use crate::assembly::{Assembler, DofMap, FillMode, Pattern};
-use crate::constraints::reduced_rhs;
+use crate::assembly::{Assembler, FillMode, Pattern};
+use crate::constraints::{reduced_rhs, Discretization};
 use crate::model::Model;
 use crate::Error;
 use fibercell_solver::CscRef;
@@ -10,8 +10,8 @@ use std::time::Instant;
 /// Numbering, pattern, values and right-hand side of the reduced system.
 #[derive(Clone, Debug)]
 pub struct ReducedSystem {
-    /// DOF numbering.
-    pub dofs: DofMap,
+    /// The numbering of the unknowns (supports prescribe DOFs).
+    pub dofs: Discretization,
     /// Sparsity pattern with slot map.
     pub pattern: Pattern,
     /// Element coloring for parallel refills.
@@ -28,8 +28,8 @@ impl ReducedSystem {
     /// Numbers the DOFs, builds the pattern and fills values and right-hand side.
     pub fn assemble(model: &Model, mode: FillMode) -> Result<Self, Error> {
         let t0 = Instant::now();
-        let dofs = DofMap::new(model);
-        let pattern = Pattern::new(model, &dofs)?;
+        let dofs = Discretization::supported(model);
+        let pattern = Pattern::new(model, dofs.reduced_indices(), dofs.n_free())?;
         let assembler = Assembler::new(model);
         let t1 = Instant::now();
         let mut values = vec![0.0; pattern.nnz()];

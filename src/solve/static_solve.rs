@@ -209,7 +209,7 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
         summary.backward_error = report.backward_error;
         x
     };
-    let u = sys.dofs.expand(&reduced);
+    let u = sys.dofs.generalized(&reduced, 1.0);
     summary.timings = timings;
     Ok(StaticSolution {
         displacements: u

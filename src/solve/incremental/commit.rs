@@ -7,7 +7,6 @@ use super::records::{ContactRecord, EnergyBalance, IncrementRecord, LowRankSizes
 use super::return_mapping::{gather, Trial};
 use super::stabilizer::stabilizer_force;
 use super::StickSlip;
-use crate::assembly::DofMap;
 use crate::constraints::{Discretization, Reaction};
 use crate::contact::{ContactPair, ContactState};
 use fibercell_solver::SolveReport;
@@ -220,7 +219,7 @@ fn support_reactions(
     let mut reaction = [0.0; 6];
     let mut reactions = Vec::with_capacity(model.supports.len());
     for s in &model.supports {
-        let g = DofMap::global(s.node, s.dof);
+        let g = Discretization::global(s.node, s.dof);
         let load: f64 = model
             .loads
             .iter()
