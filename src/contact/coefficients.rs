@@ -4,7 +4,8 @@
 //! 6 × 6 coefficient matrix. A change of state or slip direction changes D only, so it is a
 //! change of rank ≤ 6 (2 between stick and slip) in a basis fixed for the whole analysis.
 
-use super::law::{BlockVector, ContactPair, ContactState, Friction};
+use super::law::{BlockVector, ContactPair, ContactState};
+use crate::model::Friction;
 use nalgebra::{SMatrix, Vector2, Vector3, Vector6};
 
 /// The 6 × 6 coefficients D of a contact block G D Gᵀ, in the order normal, the two tangents,

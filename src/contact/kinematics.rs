@@ -10,26 +10,12 @@
 //! number of periods its image is shifted by.
 
 use crate::element::{hermite, linear, local_frame};
-use crate::model::Model;
+use crate::model::{ContactSide, Model};
 use nalgebra::{Matrix3, SMatrix};
 
 /// Up to five generalized nodes × six DOFs (four nodes of two elements, plus the driver node of a
 /// periodic cell).
 pub type JumpMatrix = SMatrix<f64, 3, 30>;
-
-/// One side of a contact.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ContactSide {
-    /// The translation of a node.
-    Node(usize),
-    /// The centerline point of an element at ξ ∈ [0, 1] (first → second node).
-    Point {
-        /// Element index.
-        element: usize,
-        /// Parameter along it.
-        xi: f64,
-    },
-}
 
 /// \[u\] = u_I − u_II = B q and \[θ\] = θ_I − θ_II = R q over `nodes` (DOFs node by node, 6
 /// each; columns beyond 6·len are 0).

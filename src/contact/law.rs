@@ -20,32 +20,13 @@
 //! at right angles its two vectors are the two fiber tangents of the thesis.
 
 use super::kinematics::Jump;
+use crate::model::Friction;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector2, Vector3};
 
 /// A 30 × 30 contact block (the top-left 6k × 6k part is used).
 pub type BlockMatrix = SMatrix<f64, 30, 30>;
 /// A 30-vector of block loads.
 pub type BlockVector = SVector<f64, 30>;
-
-/// The friction law.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub enum Friction {
-    /// Frictionless: no tangential terms.
-    #[default]
-    None,
-    /// Coulomb with cohesion: |F_t| ≤ c + μ max(N, 0).
-    Coulomb {
-        /// Friction coefficient μ ≥ 0.
-        mu: f64,
-        /// Cohesion c ≥ 0 (N): the bound at zero normal force.
-        cohesion: f64,
-    },
-    /// Tresca: |F_t| ≤ G, independent of N.
-    Tresca {
-        /// Friction bound G ≥ 0 (N).
-        bound: f64,
-    },
-}
 
 /// State of a contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -9,11 +9,10 @@ mod law;
 mod search;
 mod set;
 
+pub use crate::model::{ContactSide, Friction};
 pub use coefficients::{BlockCoefficients, BlockState};
 pub use geometry::{closest_points, ClosestPoints};
-pub use kinematics::{centerline_interpolation, jump_operator, ContactSide, Jump, JumpMatrix};
-pub use law::{
-    tangent_basis, BlockMatrix, BlockVector, ContactPair, ContactState, Friction, PairKinematics,
-};
+pub use kinematics::{centerline_interpolation, jump_operator, Jump, JumpMatrix};
+pub use law::{tangent_basis, BlockMatrix, BlockVector, ContactPair, ContactState, PairKinematics};
 pub use search::{find_candidates, find_candidates_brute_force, Candidate};
 pub use set::{default_penalty, ContactOrigin, ContactSet, PenetrationReport};

@@ -2,7 +2,7 @@
 
 use super::description::{ContactPairSpec, ContactSpec, FrictionSpec, PenetrationSpec, SideSpec};
 use super::ModelError;
-use crate::contact::{ContactSide, Friction};
+use super::{ContactSide, Friction};
 
 /// Contact settings (from `[contact]`).
 #[derive(Clone, Debug, PartialEq)]

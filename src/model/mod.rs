@@ -2,20 +2,24 @@
 //! materials, supports and nodal loads — validated on construction.
 
 mod contact_settings;
+mod contact_side;
 mod description;
 mod dof;
 mod error;
+mod friction;
 mod material;
 mod network;
 mod section;
 
 pub use contact_settings::{ContactSettings, ExplicitContact};
+pub use contact_side::ContactSide;
 pub use description::{
     CellSpec, ContactPairSpec, ContactSpec, FiberSpec, FrictionSpec, LoadSpec, MaterialSpec,
     ModelDescription, NodeSpec, PenetrationSpec, SideSpec, SupportSpec,
 };
 pub use dof::{Dof, DofSet};
 pub use error::ModelError;
+pub use friction::Friction;
 pub use material::Material;
 pub use network::{Element, Fiber, Load, Model, Node, Support};
 pub use section::Section;

@@ -1,11 +1,11 @@
 //! The validated [`Model`].
 
 use super::contact_settings::{check_pair, check_settings, ContactSettings, ExplicitContact};
+use super::ContactSide;
 use super::{
     CellSpec, ContactPairSpec, ContactSpec, Dof, Material, ModelDescription, ModelError, Section,
     SideSpec,
 };
-use crate::contact::ContactSide;
 use std::collections::HashMap;
 
 /// A node.
