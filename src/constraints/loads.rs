@@ -88,21 +88,27 @@ pub fn reduced_rhs(model: &Model, dofs: &Discretization) -> Vec<f64> {
     rhs
 }
 
-/// Reactions R_c = (K u)_c − F_c at every prescribed DOF, for the full solution `u`.
-pub fn reactions(model: &Model, dofs: &Discretization, u: &[f64]) -> Vec<Reaction> {
-    let ku = internal_forces(model, u);
-    let f = global_loads(model);
-    model
-        .supports
-        .iter()
-        .map(|s| {
-            let g = Discretization::global(s.node, s.dof);
-            debug_assert!(dofs.reduced(g).is_none());
-            Reaction {
-                node: s.node,
-                dof: s.dof,
-                value: ku[g] - f[g],
-            }
-        })
-        .collect()
+/// The support reactions R_c = f_c − α F_c at every prescribed DOF from the generalized forces
+/// `forces` (K u for a frame, K q + the contact forces in a stick/slip run) at load factor
+/// `alpha`: summed per DOF, and each. The one reaction loop of every job.
+pub fn support_reactions(model: &Model, forces: &[f64], alpha: f64) -> ([f64; 6], Vec<Reaction>) {
+    let mut sum = [0.0; 6];
+    let mut reactions = Vec::with_capacity(model.supports.len());
+    for s in &model.supports {
+        let g = Discretization::global(s.node, s.dof);
+        let load: f64 = model
+            .loads
+            .iter()
+            .filter(|l| l.node == s.node && l.dof == s.dof)
+            .map(|l| alpha * l.value)
+            .sum();
+        let value = forces[g] - load;
+        sum[s.dof.index()] += value;
+        reactions.push(Reaction {
+            node: s.node,
+            dof: s.dof,
+            value,
+        });
+    }
+    (sum, reactions)
 }

@@ -5,4 +5,4 @@ mod discretization;
 mod loads;
 
 pub use discretization::Discretization;
-pub use loads::{internal_forces, reactions, reduced_rhs, Reaction};
+pub use loads::{internal_forces, reduced_rhs, support_reactions, Reaction};

@@ -7,7 +7,7 @@ use super::records::{ContactRecord, EnergyBalance, IncrementRecord, LowRankSizes
 use super::return_mapping::{gather, Trial};
 use super::stabilizer::stabilizer_force;
 use super::StickSlip;
-use crate::constraints::{Discretization, Reaction};
+use crate::constraints::{support_reactions, Discretization};
 use crate::contact::{ContactPair, ContactState};
 use fibercell_solver::SolveReport;
 use nalgebra::{Vector2, Vector3};
@@ -207,34 +207,6 @@ fn commit_contact(
         record,
         energy,
     }
-}
-
-/// The support reactions (summed per DOF, and each) from the generalized forces `forces` at
-/// load factor `alpha`.
-fn support_reactions(
-    model: &crate::model::Model,
-    forces: &[f64],
-    alpha: f64,
-) -> ([f64; 6], Vec<Reaction>) {
-    let mut reaction = [0.0; 6];
-    let mut reactions = Vec::with_capacity(model.supports.len());
-    for s in &model.supports {
-        let g = Discretization::global(s.node, s.dof);
-        let load: f64 = model
-            .loads
-            .iter()
-            .filter(|l| l.node == s.node && l.dof == s.dof)
-            .map(|l| alpha * l.value)
-            .sum();
-        let value = forces[g] - load;
-        reaction[s.dof.index()] += value;
-        reactions.push(Reaction {
-            node: s.node,
-            dof: s.dof,
-            value,
-        });
-    }
-    (reaction, reactions)
 }
 
 /// ‖f − α F‖₂ over the free DOFs of the generalized force vector `forces` (‖f‖₂ without
