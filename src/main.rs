@@ -832,8 +832,10 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
                     LengthDistribution::Fixed { length } => length,
                     LengthDistribution::LogNormal { mean, .. } => mean,
                 });
+                // A cv of 0 is a fixed length; any other (NaN and negative ones too) goes to
+                // the generator's validation, like the parameter file's.
                 p.length = match length_cv {
-                    Some(cv) if cv > 0.0 => LengthDistribution::LogNormal { mean, cv },
+                    Some(cv) if cv != 0.0 => LengthDistribution::LogNormal { mean, cv },
                     _ => LengthDistribution::Fixed { length: mean },
                 };
             }

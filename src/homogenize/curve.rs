@@ -123,6 +123,19 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             "the number of increments must be at least 1".into(),
         ));
     }
+    let path_length = if opts.unload { 3 } else { 1 };
+    if opts.steps > crate::solve::MAX_INCREMENTS / path_length {
+        return Err(Error::InvalidOption(format!(
+            "{} increments{}: at most {} in all (every increment's results are kept)",
+            opts.steps,
+            if opts.unload {
+                " per branch of load, unload and reload"
+            } else {
+                ""
+            },
+            crate::solve::MAX_INCREMENTS
+        )));
+    }
     // The cell is set up once: pairing, contacts, percolation through the closed contacts (the
     // all-stick system must hold together) and the anchor.
     let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, true)?;

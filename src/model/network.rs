@@ -344,7 +344,7 @@ impl Model {
                     let f = *fiber_ids
                         .get(&fiber)
                         .ok_or(format!("unknown fiber {fiber}"))?;
-                    if segment + 1 >= fibers[f].nodes.len() {
+                    if segment >= fibers[f].nodes.len().saturating_sub(1) {
                         return Err(format!(
                             "fiber {fiber} has no segment {segment} (it has {})",
                             fibers[f].nodes.len() - 1

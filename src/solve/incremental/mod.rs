@@ -40,7 +40,10 @@ mod setup;
 mod stabilizer;
 
 pub use driver_couplings::DriverCouplings;
-pub use options::{IncrementalOptions, Progress, BOUND_TOLERANCE, MAX_LOW_RANK_COLUMNS};
+pub use options::{
+    IncrementalOptions, Progress, BOUND_TOLERANCE, MAX_CONTACT_RECORDS, MAX_INCREMENTS,
+    MAX_LOW_RANK_COLUMNS,
+};
 pub use records::{
     ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
 };
@@ -95,6 +98,16 @@ pub(crate) fn run_incremental(
     on_all_stick: Option<OnAllStick<'_>>,
 ) -> Result<IncrementalSolution, Error> {
     let path = load_path(opts)?;
+    let records = path.len().saturating_mul(set.pairs.len());
+    if records > MAX_CONTACT_RECORDS {
+        return Err(Error::InvalidOption(format!(
+            "{} increments × {} contacts = {records} contact records, more than the {} \
+             (about 4.5 GB) a run keeps: use fewer increments",
+            path.len(),
+            set.pairs.len(),
+            MAX_CONTACT_RECORDS
+        )));
+    }
     let mut solver = StickSlip::new(Setup::new(model, disc, set, opts)?, on_all_stick);
     for (step, &alpha) in (1..).zip(&path) {
         solver.increment(step, alpha)?;
@@ -113,6 +126,12 @@ pub(crate) fn run_incremental(
 
 /// The load factors of the increments: the options' path, else α_n = n/N.
 fn load_path(opts: &IncrementalOptions) -> Result<Vec<f64>, Error> {
+    let n = opts.path.as_ref().map_or(opts.steps, Vec::len);
+    if n > MAX_INCREMENTS {
+        return Err(Error::InvalidOption(format!(
+            "{n} increments: at most {MAX_INCREMENTS} (every increment's results are kept)"
+        )));
+    }
     let path: Vec<f64> = match &opts.path {
         Some(p) => p.clone(),
         None => (1..=opts.steps)

@@ -109,6 +109,14 @@ impl Default for IncrementalOptions {
     }
 }
 
+/// The most increments a run takes: its path, and every contact's record of every increment,
+/// are kept in memory.
+pub const MAX_INCREMENTS: usize = 1_000_000;
+
+/// The most contact records (one per contact and increment, about 90 bytes each: 4.5 GB) a run
+/// keeps; a run that would need more is refused before it starts.
+pub const MAX_CONTACT_RECORDS: usize = 50_000_000;
+
 /// State switches of one contact within an increment after which it is held in its state.
 pub(super) const CHATTER_SWITCHES: usize = 4;
 
