@@ -53,6 +53,17 @@ pub enum Error {
         /// The contacts that kept switching, described.
         contacts: Vec<String>,
     },
+    /// The state iteration of an increment settled only by holding contacts, and the held
+    /// state is not in equilibrium: the cell has a mechanism there.
+    #[error("increment {step}: no equilibrium (residual ‖R‖/‖F‖ = {residual:.1e}) with {} contact{} held in a state the contact law does not give them ({}): a fiber has lost its hold, its contacts open or sliding, so the quasi-static problem has a mechanism; bonded contacts (`--bonded`, `bonded = true` in [contact]) keep closed contacts closed, a cohesion (`cohesion` in the friction law) lets them resist sliding", held.len(), if held.len() == 1 { "" } else { "s" }, held.iter().take(10).cloned().collect::<Vec<_>>().join("; "))]
+    NoEquilibrium {
+        /// Increment (1-based).
+        step: usize,
+        /// Its equilibrium residual.
+        residual: f64,
+        /// The held contacts, described.
+        held: Vec<String>,
+    },
     /// An option is out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),

@@ -249,6 +249,12 @@ pub fn knitted(k: &Knit) -> Result<ModelDescription, Error> {
                 cohesion: 0.0,
             },
             initial_penetration: Some(PenetrationSpec::Adjust),
+            // Interlocked loops: a crossing of two loops cannot separate without the yarns
+            // passing through each other, so closed contacts stay closed (a bilateral normal
+            // spring) and only stick and slip evolve. Unilateral contacts leave a relaxed knit,
+            // whose loops merely touch, no hold in shear: under g12 all of them opened or slid
+            // in the first increment.
+            bonded: true,
             ..Default::default()
         }),
         cell: Some(CellSpec {

@@ -19,7 +19,7 @@ pub(crate) use incremental::{run_incremental, OnAllStick};
 pub use incremental::{
     solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
     IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, BOUND_TOLERANCE,
-    MAX_CONTACT_RECORDS, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
+    MAX_CONTACT_RECORDS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
 };
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
 pub use matrix_solve::{solve_matrix, MatrixSolveReport};

@@ -56,7 +56,10 @@ impl StickSlip<'_, '_> {
         } = self;
         let (model, disc, alpha) = (setup.model, setup.disc, inc.alpha);
         let mut forces = setup.elastic.internal(model, q);
-        let element_forces_norm = free_norm(disc, &forces, None);
+        // The scale of the residual: the elements' forces on every generalized DOF, the
+        // drivers' and supports' too (on the free DOFs alone they vanish at equilibrium where
+        // no contact carries anything, and R/‖K q‖ would be 0/0).
+        let element_forces_norm = forces.iter().map(|f| f * f).sum::<f64>().sqrt();
         let mut stored: f64 = 0.5 * q.iter().zip(&forces).map(|(a, b)| a * b).sum::<f64>();
         let mut stabilization_energy = 0.0;
         // Per contact, in parallel: its new slip, dissipation, generalized forces and record;
@@ -107,7 +110,7 @@ impl StickSlip<'_, '_> {
         energy.previous = (forces.clone(), q.clone());
         let applied_free = &setup.applied_free;
         let load_norm = alpha * applied_free.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let equilibrium_residual = free_norm(disc, &forces, Some((applied_free, alpha)))
+        let equilibrium_residual = free_norm(disc, &forces, (applied_free, alpha))
             / (element_forces_norm + load_norm).max(f64::MIN_POSITIVE);
         let (reaction, reactions) = support_reactions(model, &forces, alpha);
         let macro_reaction = disc
@@ -209,15 +212,15 @@ fn commit_contact(
     }
 }
 
-/// ‖f − α F‖₂ over the free DOFs of the generalized force vector `forces` (‖f‖₂ without
-/// `load`, F given on the free DOFs).
-fn free_norm(disc: &Discretization, forces: &[f64], load: Option<(&[f64], f64)>) -> f64 {
+/// ‖f − α F‖₂ over the free DOFs of the generalized force vector `forces` (F given on the
+/// free DOFs).
+fn free_norm(disc: &Discretization, forces: &[f64], (load, alpha): (&[f64], f64)) -> f64 {
     forces
         .iter()
         .enumerate()
         .filter_map(|(g, f)| {
             let r = disc.reduced(g)?;
-            Some(f - load.map_or(0.0, |(l, alpha)| alpha * l[r]))
+            Some(f - alpha * load[r])
         })
         .map(|v| v * v)
         .sum::<f64>()

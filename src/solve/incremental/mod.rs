@@ -41,8 +41,8 @@ mod stabilizer;
 
 pub use driver_couplings::DriverCouplings;
 pub use options::{
-    IncrementalOptions, Progress, BOUND_TOLERANCE, MAX_CONTACT_RECORDS, MAX_INCREMENTS,
-    MAX_LOW_RANK_COLUMNS,
+    IncrementalOptions, Progress, BOUND_TOLERANCE, MAX_CONTACT_RECORDS, MAX_HELD_RESIDUAL,
+    MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
 };
 pub use records::{
     ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
@@ -230,7 +230,7 @@ impl<'a, 'h> StickSlip<'a, 'h> {
             if changed.is_empty() {
                 inc.lap(|t| &mut t.classify);
                 self.commit(inc, iteration, &trials, report);
-                return Ok(());
+                return self.check_equilibrium(step);
             }
             if iteration == max_iterations {
                 return Err(Error::ContactNotConverged {
@@ -250,6 +250,24 @@ impl<'a, 'h> StickSlip<'a, 'h> {
             inc.lap(|t| &mut t.classify);
         }
         Err(Error::InvalidOption("no state iteration ran".into()))
+    }
+
+    /// An increment that held contacts must still be in equilibrium (see [`MAX_HELD_RESIDUAL`]).
+    fn check_equilibrium(&self, step: usize) -> Result<(), Error> {
+        let Some(last) = self.out.increments.last() else {
+            return Ok(());
+        };
+        if last.held == 0 || !(last.equilibrium_residual > MAX_HELD_RESIDUAL) {
+            return Ok(());
+        }
+        Err(Error::NoEquilibrium {
+            step,
+            residual: last.equilibrium_residual,
+            held: (0..self.setup.pairs.len())
+                .filter(|&i| self.contacts.held(i))
+                .map(|i| self.describe(i))
+                .collect(),
+        })
     }
 
     /// Solves `system`: on the reference factorization with a low-rank correction when that
