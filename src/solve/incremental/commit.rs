@@ -22,6 +22,9 @@ pub(super) struct EnergyHistory {
     pub external_work: f64,
     /// The generalized forces and displacements of the last increment.
     pub previous: (Vec<f64>, Vec<f64>),
+    /// The largest norm of the elements' forces of any increment so far: the scale of the
+    /// equilibrium residual, which on an unloading path stays that of the peak load.
+    pub force_scale: f64,
 }
 
 /// One contact's share of the commit.
@@ -58,8 +61,11 @@ impl StickSlip<'_, '_> {
         let mut forces = setup.elastic.internal(model, q);
         // The scale of the residual: the elements' forces on every generalized DOF, the
         // drivers' and supports' too (on the free DOFs alone they vanish at equilibrium where
-        // no contact carries anything, and R/‖K q‖ would be 0/0).
+        // no contact carries anything, and R/‖K q‖ would be 0/0), the largest of the run so
+        // far (unloaded to zero strain, a cell is nearly free of stress, and the contact
+        // forces' roundoff would be measured against nothing).
         let element_forces_norm = forces.iter().map(|f| f * f).sum::<f64>().sqrt();
+        energy.force_scale = energy.force_scale.max(element_forces_norm);
         let mut stored: f64 = 0.5 * q.iter().zip(&forces).map(|(a, b)| a * b).sum::<f64>();
         let mut stabilization_energy = 0.0;
         // Per contact, in parallel: its new slip, dissipation, generalized forces and record;
@@ -111,7 +117,7 @@ impl StickSlip<'_, '_> {
         let applied_free = &setup.applied_free;
         let load_norm = alpha * applied_free.iter().map(|v| v * v).sum::<f64>().sqrt();
         let equilibrium_residual = free_norm(disc, &forces, (applied_free, alpha))
-            / (element_forces_norm + load_norm).max(f64::MIN_POSITIVE);
+            / (energy.force_scale + load_norm).max(f64::MIN_POSITIVE);
         let (reaction, reactions) = support_reactions(model, &forces, alpha);
         let macro_reaction = disc
             .driver()

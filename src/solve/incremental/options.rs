@@ -121,8 +121,9 @@ pub const MAX_CONTACT_RECORDS: usize = 50_000_000;
 /// ([`crate::Error::NoEquilibrium`]) rather than a result: held contacts leave residuals of
 /// 10⁻⁶–10⁻⁴ where a few chatter on generated non-wovens, 1.5·10⁻² where one slides into a
 /// near-mechanism held by stabilizing springs alone (`tests/curve_nonwoven_convergence.rs`),
-/// and 0.2–1 where the held state is a mechanism (a knitted cell whose contacts all open or
-/// slide under shear, whose resultants then grew to 10¹⁴³; a knit unloaded to zero strain).
+/// 6·10⁻⁴ where a knit unloaded to zero strain holds its frictionless contacts, and 0.2–1
+/// where the held state is a mechanism (a knitted cell with unilateral contacts, all of which
+/// open or slide under shear: its resultants then grew to 10¹⁴³).
 pub const MAX_HELD_RESIDUAL: f64 = 0.1;
 
 /// State switches of one contact within an increment after which it is held in its state.

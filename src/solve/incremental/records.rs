@@ -59,7 +59,8 @@ pub struct IncrementRecord {
     /// (the return mapping's normal force, stick force or bound c + μ max(N, 0) along the slip
     /// direction, not the linearization the last system was assembled with), K q the
     /// elements' forces, whose norm is taken over every generalized DOF (with the drivers' and
-    /// the supports'). About the solves' accuracy and the bounds' fixed-point tolerance; with
+    /// the supports') and is the largest of the run so far (on an unloading path, the peak
+    /// load's). About the solves' accuracy and the bounds' fixed-point tolerance; with
     /// held contacts, how far their state is from equilibrium (an error above
     /// [`MAX_HELD_RESIDUAL`](crate::solve::MAX_HELD_RESIDUAL)).
     pub equilibrium_residual: f64,
