@@ -142,6 +142,18 @@ proptest! {
             let got = DMatrix::from_fn(pair.size(), pair.size(), &k);
             prop_assert!((&got - &expected).amax() <= 1e-12 * expected.amax(), "stick {stick}");
         }
+        // Each spring alone from the one production formula: K_N, K_T^st, K_R.
+        let (pn, pt, pr) = (pair.penalty_normal, pair.penalty_tangent, pair.penalty_rotation);
+        for (name, (p, q, r), part) in [
+            ("K_N", (pn, 0.0, 0.0), kn),
+            ("K_T^st", (0.0, pt, 0.0), kt),
+            ("K_R", (0.0, 0.0, pr), pair.rotation()),
+        ] {
+            let k = pair.springs(p, q, r);
+            let expected = block(&pair, &part);
+            let got = DMatrix::from_fn(pair.size(), pair.size(), &k);
+            prop_assert!((&got - &expected).amax() <= 1e-12 * expected.amax().max(1e-300), "{name}");
+        }
     }
 
     /// G D Gᵀ from the block coefficients equals every block the incremental solver assembles

@@ -74,20 +74,28 @@ fn the_default_knit_unloads_to_zero() {
 }
 
 /// With unilateral contacts the relaxed knit has no hold in shear: every contact opens or
-/// slides in the first increment and the held state is a mechanism. That is an error naming
-/// the increment, the held contacts and the remedy — before, the curve "completed" with
-/// resultants of 10¹⁴³ N/m and residuals of order 1.
+/// slides in the first increment and the held state is a mechanism. That is an error — before,
+/// the curve "completed" with resultants of 10¹⁴³ N/m and residuals of order 1. Which error
+/// depends on the last bits of the factorization: where the mechanism's pivot comes out as
+/// roundoff, the solve returns huge displacements and the increment is `NoEquilibrium`, naming
+/// the increment, the held contacts and the remedy (the release build); where it comes out
+/// zero, the factorization reports the singular node and fiber (the test profile).
 #[test]
 fn a_knit_without_hold_is_an_error_not_garbage() {
     let mut desc = knitted(&Knit::default()).expect("knit");
     desc.contact.as_mut().expect("contact").bonded = false;
     let e = curve(&desc, "g12=0.01").expect_err("no equilibrium");
-    assert!(matches!(e, Error::NoEquilibrium { step: 1, .. }), "{e}");
     let text = e.to_string();
-    assert!(
-        text.contains("--bonded") && text.contains("contact 1 ("),
-        "{text}"
-    );
+    match e {
+        Error::NoEquilibrium { step: 1, .. } => assert!(
+            text.contains("--bonded") && text.contains("contact 1 ("),
+            "{text}"
+        ),
+        _ => assert!(
+            text.contains("singular") && text.contains("fiber"),
+            "neither NoEquilibrium at increment 1 nor a singular stiffness: {text}"
+        ),
+    }
 }
 
 /// A cell without contacts (the default geotextile) is linear, and its residual is measured

@@ -136,24 +136,45 @@ impl ContactPair {
     }
 
     /// K_N + K_R (4.53), plus K_T^st (4.58) when `stick`, entry (row, column) of the leading
-    /// [`ContactPair::size`] square block: Bᵀ S B + p_R RᵀR with the 3 × 3
-    /// S = p_N n nᵀ (+ p_T (t₁t₁ᵀ + t₂t₂ᵀ)), six products per entry and no 30 × 30 temporaries
-    /// (the value fill of closed contacts).
+    /// [`ContactPair::size`] square block (the value fill of closed contacts): see
+    /// [`ContactPair::springs`].
     pub fn closed_stiffness(&self, stick: bool) -> impl Fn(usize, usize) -> f64 + Sync + '_ {
-        let sb = self.jump_stiffness(stick) * self.jump.b;
-        let (b, r, pr) = (&self.jump.b, &self.jump.r, self.penalty_rotation);
-        move |i, j| b.column(i).dot(&sb.column(j)) + pr * r.column(i).dot(&r.column(j))
+        let p_t = if stick { self.penalty_tangent } else { 0.0 };
+        self.springs(self.penalty_normal, p_t, self.penalty_rotation)
+    }
+
+    /// The one formula of a contact's springs in production code: the normal spring p_n, the
+    /// tangential one p_t and the rotational one p_r as Bᵀ S B + p_r RᵀR with the 3 × 3
+    /// S = p_n n nᵀ + p_t (t₁t₁ᵀ + t₂t₂ᵀ), entry (row, column) of the leading
+    /// [`ContactPair::size`] square block, six products per entry and no 30 × 30 temporaries.
+    /// K_N = springs(p_N, 0, 0) (4.53), K_T^st = springs(0, p_T, 0) (4.58), K_R =
+    /// springs(0, 0, p_R). [`ContactPair::normal`], [`ContactPair::stick`] and
+    /// [`ContactPair::rotation`] are the same matrices as outer products, the independent forms
+    /// the tests check this one against.
+    pub fn springs(
+        &self,
+        p_n: f64,
+        p_t: f64,
+        p_r: f64,
+    ) -> impl Fn(usize, usize) -> f64 + Sync + '_ {
+        let sb = self.spring_matrix(p_n, p_t) * self.jump.b;
+        let (b, r) = (&self.jump.b, &self.jump.r);
+        move |i, j| b.column(i).dot(&sb.column(j)) + p_r * r.column(i).dot(&r.column(j))
     }
 
     /// The 3 × 3 S = p_N n nᵀ (+ p_T (t₁t₁ᵀ + t₂t₂ᵀ) when `stick`) of
     /// [`ContactPair::closed_stiffness`]: the jump's stiffness.
     #[inline]
     pub fn jump_stiffness(&self, stick: bool) -> Matrix3<f64> {
-        let (n, [t1, t2]) = (&self.normal, &self.tangents);
         let p_t = if stick { self.penalty_tangent } else { 0.0 };
-        Matrix3::from_fn(|i, j| {
-            self.penalty_normal * (n[i] * n[j]) + p_t * (t1[i] * t1[j] + t2[i] * t2[j])
-        })
+        self.spring_matrix(self.penalty_normal, p_t)
+    }
+
+    /// S = p_n n nᵀ + p_t (t₁t₁ᵀ + t₂t₂ᵀ).
+    #[inline]
+    fn spring_matrix(&self, p_n: f64, p_t: f64) -> Matrix3<f64> {
+        let (n, [t1, t2]) = (&self.normal, &self.tangents);
+        Matrix3::from_fn(|i, j| p_n * (n[i] * n[j]) + p_t * (t1[i] * t1[j] + t2[i] * t2[j]))
     }
 
     /// F_N + F_T of a stuck contact with accumulated slip `slip` (4.53, 4.58), the load that

@@ -133,9 +133,13 @@ impl Scatter<'_, '_> {
     /// and its load, of sliding contact i.
     fn sliding_block(&self, i: usize) -> (BlockMatrix, BlockVector) {
         let (pair, c) = (&self.setup.pairs[i], self.contacts);
-        let (mut k, mut f) = pair.normal();
+        // K_N + K_R and F_N: the closed contact's springs without the tangential one.
+        let m = pair.size();
+        let closed = pair.closed_stiffness(false);
+        let mut k = BlockMatrix::from_fn(|r, s| if r < m && s < m { closed(r, s) } else { 0.0 });
+        let mut f = pair.stick_load(&Vector2::zeros());
         let (ks, fs) = pair.slip(c.friction_of(i), &c.directions[i]);
-        k += ks + pair.rotation();
+        k += ks;
         f += fs;
         if c.perpendicular[i].0 > 0.0 {
             let (kp, fp) = pair.slip_perpendicular(

@@ -2,16 +2,21 @@
 //! [`IncrementalOptions::stabilization`](super::IncrementalOptions::stabilization)(super::IncrementalOptions::stabilization)).
 
 use crate::contact::{BlockMatrix, BlockVector, ContactPair, ContactState};
-use nalgebra::Vector2;
 
 /// The unscaled stabilizing spring of a contact in `state` (see
 /// [`IncrementalOptions::stabilization`](super::IncrementalOptions::stabilization)): K_N + K_T^st + K_R when open, K_T^st when sliding.
 pub(super) fn stabilizer(pair: &ContactPair, state: ContactState) -> BlockMatrix {
-    let (kt, _) = pair.stick(&Vector2::zeros());
-    match state {
-        ContactState::Open => pair.normal().0 + kt + pair.rotation(),
-        _ => kt,
-    }
+    let (p_n, p_t, p_r) = (
+        pair.penalty_normal,
+        pair.penalty_tangent,
+        pair.penalty_rotation,
+    );
+    let k = match state {
+        ContactState::Open => pair.springs(p_n, p_t, p_r),
+        _ => pair.springs(0.0, p_t, 0.0),
+    };
+    let m = pair.size();
+    BlockMatrix::from_fn(|r, c| if r < m && c < m { k(r, c) } else { 0.0 })
 }
 
 /// [`stabilizer`]`(pair, state) q` from the jump basis G, Σₐ dₐ gₐ (gₐ · q) with the stick
