@@ -2,11 +2,13 @@
 //! slot map (built once), and the value fill (serial or parallel, refilled in place).
 
 mod coloring;
+mod element_blocks;
 mod fill;
 mod pattern;
 mod shared;
 
 pub use coloring::{color_blocks, color_elements};
+pub use element_blocks::ElementBlocks;
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
 pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};
 pub(crate) use shared::{prefetch, SharedMut};

@@ -7,7 +7,7 @@
 //! Contacts are searched with the periodic images, so crossings on the boundary count.
 
 use super::contact_columns::ContactColumns;
-use crate::assembly::{color_blocks, element_stiffness, Pattern, SharedMut, NO_SLOT};
+use crate::assembly::{color_blocks, ElementBlocks, Pattern, SharedMut, NO_SLOT};
 use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain, Periodicity};
 use crate::constraints::Discretization;
 use crate::contact::{ContactPair, ContactSet, ContactSide};
@@ -15,7 +15,7 @@ use crate::model::{Dof, Model};
 use crate::solve::DriverCouplings;
 use crate::Error;
 use fibercell_solver::{CscMatrix, SolverError};
-use nalgebra::{DMatrix, SMatrix};
+use nalgebra::SMatrix;
 use rayon::prelude::*;
 
 /// The assembled values of a periodic cell problem.
@@ -131,8 +131,8 @@ pub struct PeriodicSystem {
     pub discretization: Discretization,
     /// Sparsity pattern of K_ff: elements, then closed contacts.
     pub pattern: Pattern,
-    /// Per element: its generalized nodes and T, None when T = I on its own nodes.
-    elements: Vec<Option<(Vec<usize>, DMatrix<f64>)>>,
+    /// Every element's block on the generalized nodes.
+    elements: ElementBlocks,
     pub(super) contacts: Vec<ContactPair>,
     /// Elements by color: no two of a color share a generalized node other than the driver.
     element_colors: Vec<Vec<usize>>,
@@ -202,31 +202,25 @@ impl PeriodicSystem {
             .filter(|&i| set.pairs[i].gap <= 0.0)
             .collect();
         let discretization = Discretization::periodic(model, &periodicity, &[0.0; 6], anchor);
-        let elements: Vec<Option<(Vec<usize>, DMatrix<f64>)>> = model
-            .elements()
-            .iter()
-            .map(|e| discretization.non_identity_block(&e.nodes))
-            .collect();
+        let elements = ElementBlocks::new(model, &discretization);
         let contacts: Vec<ContactPair> = closed
             .iter()
             .map(|&i| discretization.contact_pair(&set.pairs[i]))
             .collect();
-        let blocks: Vec<&[usize]> = elements
-            .iter()
-            .zip(model.elements())
-            .map(|(b, e)| b.as_ref().map_or(&e.nodes[..], |(g, _)| &g[..]))
+        let n_elements = model.elements().len();
+        let blocks: Vec<&[usize]> = (0..n_elements)
+            .map(|e| elements.gnodes_of(model, e))
             .chain(contacts.iter().map(|c| &c.jump.nodes[..]))
             .collect();
         let (driver, n_gnodes) = (discretization.driver(), discretization.n_gnodes());
-        let element_colors =
-            color_blocks(n_gnodes, blocks[..elements.len()].iter().copied(), driver);
+        let element_colors = color_blocks(n_gnodes, blocks[..n_elements].iter().copied(), driver);
         timings.blocks = clock.elapsed().as_secs_f64();
         let clock = std::time::Instant::now();
         let pattern = Pattern::from_blocks(
             discretization.reduced_indices(),
             discretization.n_free(),
             &blocks,
-            elements.len(),
+            n_elements,
         )?;
         let contact_columns = ContactColumns::new(n_gnodes, driver, &contacts, &pattern);
         timings.pattern = clock.elapsed().as_secs_f64();
@@ -330,17 +324,10 @@ impl PeriodicSystem {
     /// Adds Tᵀ K T of every element: the colors one after another, the elements of a color in
     /// parallel, each writing its own entries (the sums do not depend on the number of threads).
     pub fn add_elements(&self, model: &Model, out: &mut PeriodicValues) {
-        let els = model.elements();
         self.add_colored(out, &self.element_colors, |e, sink| {
-            let k = element_stiffness(model, e);
             let slots = self.pattern.element_slots(e);
-            match &self.elements[e] {
-                None => sink.add(&els[e].nodes, |r, c| k[(r, c)], slots),
-                Some((g, t)) => {
-                    let tkt = t.transpose() * DMatrix::from_fn(12, 12, |r, c| k[(r, c)]) * t;
-                    sink.add(g, |r, c| tkt[(r, c)], slots)
-                }
-            }
+            self.elements
+                .with_block(model, e, |gnodes, k| sink.add(gnodes, k, slots))
         });
     }
 

@@ -1,7 +1,7 @@
 //! The assembled reduced system K_ff u_f = F_f − K_fc u_c.
 
-use crate::assembly::{Assembler, FillMode, Pattern};
-use crate::constraints::{reduced_rhs, Discretization};
+use crate::assembly::{Assembler, ElementBlocks, FillMode, Pattern};
+use crate::constraints::Discretization;
 use crate::model::Model;
 use crate::Error;
 use fibercell_solver::CscRef;
@@ -16,6 +16,8 @@ pub struct ReducedSystem {
     pub pattern: Pattern,
     /// Element coloring for parallel refills.
     pub assembler: Assembler,
+    /// The element blocks (the right-hand side and the internal forces).
+    pub elements: ElementBlocks,
     /// Values of K_ff (both triangles).
     pub values: Vec<f64>,
     /// F_f − K_fc u_c.
@@ -34,12 +36,14 @@ impl ReducedSystem {
         let t1 = Instant::now();
         let mut values = vec![0.0; pattern.nnz()];
         assembler.fill(model, &pattern, &mut values, mode)?;
-        let rhs = reduced_rhs(model, &dofs);
+        let elements = ElementBlocks::new(model, &dofs);
+        let rhs = elements.rhs(model, &dofs);
         let t2 = Instant::now();
         Ok(ReducedSystem {
             dofs,
             pattern,
             assembler,
+            elements,
             values,
             rhs,
             seconds: ((t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64()),

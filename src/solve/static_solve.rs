@@ -2,7 +2,7 @@
 
 use super::{check_supported, ReducedSystem, SolverConfig, SolverKind};
 use crate::assembly::FillMode;
-use crate::constraints::{internal_forces, support_reactions, Reaction};
+use crate::constraints::{support_reactions, Reaction};
 use crate::model::{Dof, Model};
 use crate::Error;
 use fibercell_solver::{solve_checked, Ordering, SolverError};
@@ -216,7 +216,7 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
             .chunks(6)
             .map(|c| [c[0], c[1], c[2], c[3], c[4], c[5]])
             .collect(),
-        reactions: support_reactions(model, &internal_forces(model, &u), 1.0).1,
+        reactions: support_reactions(model, &sys.elements.internal(model, &u), 1.0).1,
         summary,
     })
 }

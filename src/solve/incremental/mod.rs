@@ -27,7 +27,6 @@ mod classify;
 mod commit;
 mod contact_states;
 mod driver_couplings;
-mod elastic;
 mod factor_reuse;
 mod factorize;
 mod factors;

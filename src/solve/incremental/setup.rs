@@ -2,10 +2,10 @@
 //! elements and every candidate contact block, the elastic values and load, the contact
 //! colors for parallel scattering, and the run's contact law and tolerances.
 
-use super::elastic::Elastic;
 use super::options::SLIP_DIRECTION_TOLERANCE;
 use super::return_mapping::Law;
 use super::IncrementalOptions;
+use crate::assembly::ElementBlocks;
 use crate::assembly::{color_blocks, Pattern};
 use crate::constraints::Discretization;
 use crate::contact::{ContactPair, ContactSet, Friction};
@@ -31,7 +31,7 @@ pub(super) struct Setup<'a> {
     /// Per contact, the slip direction of a frictionless pre-run (thesis Remark 4.38), when
     /// [`IncrementalOptions::fixed_slip_direction`] asks for it.
     pub fixed: Vec<Option<Vector2<f64>>>,
-    pub elastic: Elastic,
+    pub elastic: ElementBlocks,
     /// Elements ∪ every candidate contact block, on the free DOFs.
     pub pattern: Pattern,
     /// K of the elements in the pattern's slots.
@@ -85,7 +85,7 @@ impl<'a> Setup<'a> {
             && !opts.consistent_coulomb_tangent;
         let fixed = fixed_directions(model, disc, &set, opts)?;
         let pairs: Vec<ContactPair> = set.pairs.iter().map(|p| disc.contact_pair(p)).collect();
-        let elastic = Elastic::new(model, disc);
+        let elastic = ElementBlocks::new(model, disc);
         let mut blocks: Vec<Vec<usize>> = (0..model.elements().len())
             .map(|e| elastic.gnodes_of(model, e).to_vec())
             .collect();
@@ -123,7 +123,7 @@ impl<'a> Setup<'a> {
                 .is_ok_and(|s| !s.capabilities().iterative);
         Ok(Setup {
             rhs_full: elastic.rhs(model, disc),
-            applied_free: Elastic::applied(model, disc),
+            applied_free: ElementBlocks::applied(model, disc),
             model,
             disc,
             opts,

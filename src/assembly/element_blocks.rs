@@ -1,16 +1,23 @@
-//! The elastic part of a stick/slip system on a discretization: the element blocks on
-//! generalized nodes, their load with prescribed DOFs, and their internal forces.
+//! The element blocks of any discretization — the one place element stiffnesses become
+//! blocks on unknowns: Tᵀ K T on each element's generalized nodes (K itself on its own nodes
+//! where no node is constrained, the common case), their fill into a pattern, the right-hand
+//! side F_f − K_fc u_c, and the internal forces K q.
+//!
+//! With K split into free (f) and prescribed (c) DOFs, K_ff u_f = F_f − K_fc u_c; the reduced
+//! matrix K_ff is a principal submatrix of the symmetric K and stays symmetric.
 
-use crate::assembly::{element_stiffness, Assembler, Pattern, NO_SLOT};
-use crate::constraints::{internal_forces, Discretization};
+use super::{element_stiffness, Assembler, FillMode, Pattern, NO_SLOT};
+use crate::constraints::Discretization;
 use crate::model::Model;
 use crate::Error;
+use fibercell_solver::SolverError;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-/// The elastic part on a discretization: element blocks on generalized nodes.
-pub(super) struct Elastic {
+/// Every element's block on the generalized nodes of a discretization.
+#[derive(Debug)]
+pub struct ElementBlocks {
     /// Generalized nodes and T of every element (None: the element's own nodes, T = I).
     maps: Vec<Option<(Vec<usize>, DMatrix<f64>)>>,
     /// The discretization is the identity (a supported structure).
@@ -20,13 +27,25 @@ pub(super) struct Elastic {
     cache: OnceLock<Option<Vec<DMatrix<f64>>>>,
 }
 
-/// Largest memory the element matrices of the commit are kept in.
+impl Clone for ElementBlocks {
+    /// The maps; the cache is rebuilt on first use.
+    fn clone(&self) -> Self {
+        ElementBlocks {
+            maps: self.maps.clone(),
+            identity: self.identity,
+            cache: OnceLock::new(),
+        }
+    }
+}
+
+/// Largest memory the element matrices are kept in.
 const ELEMENT_CACHE_BYTES: usize = 512 << 20;
 
-impl Elastic {
-    pub(super) fn new(model: &Model, disc: &Discretization) -> Self {
+impl ElementBlocks {
+    /// The blocks of `model`'s elements on `disc`.
+    pub fn new(model: &Model, disc: &Discretization) -> Self {
         let identity = disc.is_identity();
-        Elastic {
+        ElementBlocks {
             maps: model
                 .elements()
                 .iter()
@@ -43,12 +62,48 @@ impl Elastic {
         }
     }
 
+    /// The generalized nodes of element e's block.
+    pub fn gnodes_of<'a>(&'a self, model: &'a Model, e: usize) -> &'a [usize] {
+        match &self.maps[e] {
+            Some((g, _)) => g,
+            None => &model.elements()[e].nodes,
+        }
+    }
+
+    /// Tᵀ K T of element e on its generalized nodes.
+    pub fn matrix(&self, model: &Model, e: usize) -> DMatrix<f64> {
+        let k = element_stiffness(model, e);
+        let k = DMatrix::from_fn(12, 12, |r, c| k[(r, c)]);
+        match &self.maps[e] {
+            Some((_, t)) => t.transpose() * k * t,
+            None => k,
+        }
+    }
+
+    /// `f(generalized nodes, entry)` of element e's block: K itself where T = I (no copy),
+    /// else Tᵀ K T.
+    pub fn with_block<R>(
+        &self,
+        model: &Model,
+        e: usize,
+        f: impl FnOnce(&[usize], &dyn Fn(usize, usize) -> f64) -> R,
+    ) -> R {
+        let k = element_stiffness(model, e);
+        match &self.maps[e] {
+            None => f(&model.elements()[e].nodes, &|r, c| k[(r, c)]),
+            Some((g, t)) => {
+                let tkt = t.transpose() * DMatrix::from_fn(12, 12, |r, c| k[(r, c)]) * t;
+                f(g, &|r, c| tkt[(r, c)])
+            }
+        }
+    }
+
     /// Every element's Tᵀ K T when they fit in [`ELEMENT_CACHE_BYTES`].
     fn cached(&self, model: &Model) -> Option<&[DMatrix<f64>]> {
         self.cache
             .get_or_init(|| {
                 let bytes: usize = (0..self.maps.len())
-                    .map(|e| 8 * (6 * self.block_nodes(model, e)).pow(2))
+                    .map(|e| 8 * (6 * self.gnodes_of(model, e).len()).pow(2))
                     .sum();
                 (bytes <= ELEMENT_CACHE_BYTES)
                     .then(|| self.matrices(model).map(|(_, k)| k).collect())
@@ -61,32 +116,6 @@ impl Elastic {
         match self.cached(model) {
             Some(all) => all.iter().enumerate().for_each(|(e, k)| f(e, k)),
             None => self.matrices(model).for_each(|(e, k)| f(e, &k)),
-        }
-    }
-
-    /// Nodes of element e's block.
-    fn block_nodes(&self, model: &Model, e: usize) -> usize {
-        match &self.maps[e] {
-            Some((g, _)) => g.len(),
-            None => model.elements()[e].nodes.len(),
-        }
-    }
-
-    /// The generalized nodes of element e's block.
-    pub(super) fn gnodes_of<'a>(&'a self, model: &'a Model, e: usize) -> &'a [usize] {
-        match &self.maps[e] {
-            Some((g, _)) => g,
-            None => &model.elements()[e].nodes,
-        }
-    }
-
-    /// Tᵀ K T of element e on its generalized nodes.
-    pub(super) fn matrix(&self, model: &Model, e: usize) -> DMatrix<f64> {
-        let k = element_stiffness(model, e);
-        let k = DMatrix::from_fn(12, 12, |r, c| k[(r, c)]);
-        match &self.maps[e] {
-            Some((_, t)) => t.transpose() * k * t,
-            None => k,
         }
     }
 
@@ -106,16 +135,25 @@ impl Elastic {
         })
     }
 
-    pub(super) fn fill(
+    /// Overwrites `values` (length `pattern.nnz()`, element slots on these blocks) with K_ff.
+    pub fn fill(
         &self,
         model: &Model,
         pattern: &Pattern,
         values: &mut [f64],
-        mode: crate::assembly::FillMode,
+        mode: FillMode,
     ) -> Result<(), Error> {
         if self.identity {
             Assembler::new(model).fill(model, pattern, values, mode)?;
             return Ok(());
+        }
+        if values.len() != pattern.nnz() {
+            return Err(SolverError::DimensionMismatch(format!(
+                "{} values for a pattern of {} entries",
+                values.len(),
+                pattern.nnz()
+            ))
+            .into());
         }
         values.iter_mut().for_each(|v| *v = 0.0);
         self.for_each_matrix(model, |e, k| {
@@ -134,7 +172,7 @@ impl Elastic {
     }
 
     /// The nodal loads F of the model on the free DOFs (α = 1).
-    pub(super) fn applied(model: &Model, disc: &Discretization) -> Vec<f64> {
+    pub fn applied(model: &Model, disc: &Discretization) -> Vec<f64> {
         let mut rhs = vec![0.0; disc.n_free()];
         for l in &model.loads {
             let (gnodes, t) = disc.block(&[l.node]);
@@ -147,10 +185,13 @@ impl Elastic {
         rhs
     }
 
-    /// The load of the linear system for α = 1: F and the products of the elements with the
-    /// prescribed DOFs.
-    pub(super) fn rhs(&self, model: &Model, disc: &Discretization) -> Vec<f64> {
+    /// The right-hand side F_f − K_fc u_c for α = 1: the nodal loads and the products of the
+    /// elements with the prescribed DOFs. The one right-hand side of every job.
+    pub fn rhs(&self, model: &Model, disc: &Discretization) -> Vec<f64> {
         let mut rhs = Self::applied(model, disc);
+        if !disc.has_nonzero_prescribed() {
+            return rhs;
+        }
         for e in 0..self.maps.len() {
             let gnodes = self.gnodes_of(model, e);
             let prescribed = |c: usize| {
@@ -163,24 +204,25 @@ impl Elastic {
             if !(0..6 * gnodes.len()).any(|c| prescribed(c).is_some()) {
                 continue;
             }
-            let k = self.matrix(model, e);
-            for r in 0..k.nrows() {
-                if let Some(i) = disc.reduced(6 * gnodes[r / 6] + r % 6) {
-                    for c in 0..k.ncols() {
-                        if let Some(v) = prescribed(c) {
-                            rhs[i] -= k[(r, c)] * v;
+            self.with_block(model, e, |gnodes, k| {
+                for r in 0..6 * gnodes.len() {
+                    if let Some(i) = disc.reduced(6 * gnodes[r / 6] + r % 6) {
+                        for c in 0..6 * gnodes.len() {
+                            if let Some(v) = prescribed(c) {
+                                rhs[i] -= k(r, c) * v;
+                            }
                         }
                     }
                 }
-            }
+            });
         }
         rhs
     }
 
     /// Generalized internal forces K q for the full generalized vector q.
-    pub(super) fn internal(&self, model: &Model, q: &[f64]) -> Vec<f64> {
+    pub fn internal(&self, model: &Model, q: &[f64]) -> Vec<f64> {
         if self.identity {
-            return internal_forces(model, &q[..6 * model.nodes.len()]);
+            return identity_internal(model, &q[..6 * model.nodes.len()]);
         }
         // Column by column, a node's six rows at a time (contiguous in K and in `out`).
         let add = |out: &mut [f64], e: usize, k: &DMatrix<f64>| {
@@ -226,4 +268,33 @@ impl Elastic {
             }
         }
     }
+}
+
+/// K u over all global DOFs of a supported structure, element by element (u: 6 per node).
+fn identity_internal(model: &Model, u: &[f64]) -> Vec<f64> {
+    let contributions: Vec<(usize, [f64; 12])> = (0..model.elements().len())
+        .into_par_iter()
+        .map(|e| {
+            let k = element_stiffness(model, e);
+            let nodes = model.elements()[e].nodes;
+            let mut ue = [0.0; 12];
+            for (a, &nd) in nodes.iter().enumerate() {
+                ue[6 * a..6 * a + 6].copy_from_slice(&u[6 * nd..6 * nd + 6]);
+            }
+            let mut fe = [0.0; 12];
+            for (r, f) in fe.iter_mut().enumerate() {
+                *f = (0..12).map(|c| k[(r, c)] * ue[c]).sum();
+            }
+            (e, fe)
+        })
+        .collect();
+    let mut out = vec![0.0; u.len()];
+    for (e, fe) in contributions {
+        for (a, &nd) in model.elements()[e].nodes.iter().enumerate() {
+            for d in 0..6 {
+                out[6 * nd + d] += fe[6 * a + d];
+            }
+        }
+    }
+    out
 }
