@@ -465,14 +465,14 @@ fn low_rank_switch(
         let columns = t.elapsed().as_secs_f64();
         let cap = low_rank.capacitance(&changes);
         let capacitance = t.elapsed().as_secs_f64() - columns;
-        let x = low_rank.solve_from_taken(a0, &cap, reference, &vec![0.0; cap.order()])?;
+        let x = low_rank.solve_from_taken(a0, &cap, reference, &vec![0.0; cap.loads()])?;
         let first = t.elapsed().as_secs_f64();
         firsts.push((first, [columns, capacitance, first - columns - capacitance]));
         error = error.max(backward_error(a, &x, rhs));
         // The next solve as in a stick/slip iteration: the load changed within the switched
         // contacts' columns, solved from A₀⁻¹ b₀ of the increment (known) with one solve.
         let x0 = low_rank.reference(a0, rhs.to_vec())?;
-        let load = vec![1.0; cap.order()];
+        let load = vec![1.0; cap.loads()];
         let t = Instant::now();
         let cap = low_rank.capacitance(&changes);
         low_rank.solve_from(a0, &cap, &x0, &load)?;

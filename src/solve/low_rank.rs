@@ -60,6 +60,12 @@ impl ContactChange {
         self.columns_needed() > 0
     }
 
+    /// Whether the block changed (not only the load): the contact is then a row of the
+    /// capacitance matrix.
+    pub(crate) fn changes_block(&self) -> bool {
+        self.stiffness.iter().any(|&v| v != 0.0)
+    }
+
     /// How many leading entries of the column order the change needs (0: none).
     fn columns_needed(&self) -> usize {
         columns_needed(&self.stiffness, &self.load)
@@ -142,12 +148,17 @@ fn one_vector_par(values: usize) -> Par {
     }
 }
 
-/// The factorized capacitance matrix I + E S of one set of changes.
+/// The factorized capacitance matrix I + E S of one set of changes: of the contacts whose
+/// block changed; those whose load changed alone (E = 0, e.g. a stuck contact with a new
+/// slip) only add their U Δχ.
 pub(crate) struct Capacitance {
-    /// Per changed contact: its columns and its E (row-major, in column order).
+    /// Per contact whose block changed: its columns and its E (row-major, in column order).
     blocks: Vec<(Vec<usize>, Vec<f64>)>,
-    /// The changed contacts' columns, block after block.
+    /// Their columns, block after block: the rows of the capacitance matrix.
     active: Vec<usize>,
+    /// Every changed contact's columns, in the order of their load
+    /// ([`LowRankCorrection::active_load`]).
+    loaded: Vec<usize>,
     factor: CapacitanceFactor,
 }
 
@@ -195,6 +206,11 @@ impl Capacitance {
     pub(crate) fn order(&self) -> usize {
         self.active.len()
     }
+
+    /// The number of load coefficients it goes with (every changed contact's columns).
+    pub(crate) fn loads(&self) -> usize {
+        self.loaded.len()
+    }
 }
 
 impl LowRankCorrection {
@@ -232,7 +248,8 @@ impl LowRankCorrection {
         changes.iter().fold((0, 0), |(order, new), ch| {
             let have = self.owned[ch.contact].len();
             let need = ch.columns_needed().max(have);
-            (order + need, new + need - have)
+            let rows = if ch.changes_block() { need } else { 0 };
+            (order + rows, new + need - have)
         })
     }
 
@@ -459,8 +476,13 @@ impl LowRankCorrection {
     /// Factorizes I + E S for `changes` (each contact's columns must be there: see
     /// [`LowRankCorrection::extend`]).
     pub(crate) fn capacitance(&self, changes: &[ContactChange]) -> Capacitance {
+        let loaded: Vec<usize> = changes
+            .iter()
+            .flat_map(|ch| self.owned[ch.contact].iter().copied())
+            .collect();
         let blocks: Vec<(Vec<usize>, Vec<f64>)> = changes
             .iter()
+            .filter(|ch| ch.changes_block())
             .map(|ch| {
                 let e = &ch.stiffness;
                 let cols = self.owned[ch.contact].clone();
@@ -484,6 +506,7 @@ impl LowRankCorrection {
                 return Capacitance {
                     blocks,
                     active,
+                    loaded,
                     factor: CapacitanceFactor::Cholesky { c, l },
                 };
             }
@@ -509,6 +532,7 @@ impl LowRankCorrection {
         Capacitance {
             blocks,
             active,
+            loaded,
             factor: CapacitanceFactor::Lu(lu),
         }
     }
@@ -620,7 +644,7 @@ impl LowRankCorrection {
         b: &[f64],
     ) -> Result<Vec<f64>, SolverError> {
         let reference = self.reference(a0, b.to_vec())?;
-        self.solve_from_taken(a0, cap, reference, &vec![0.0; cap.order()])
+        self.solve_from_taken(a0, cap, reference, &vec![0.0; cap.loads()])
     }
 
     /// [`LowRankCorrection::solve_from`] when `reference` is not needed afterwards: a forward
@@ -696,7 +720,7 @@ impl LowRankCorrection {
             .zip(projected)
             .map(|(&c, p)| {
                 p + cap
-                    .active
+                    .loaded
                     .iter()
                     .zip(load)
                     .map(|(&l, v)| self.s[(c, l)] * v)
@@ -704,10 +728,13 @@ impl LowRankCorrection {
             })
             .collect();
         let z = cap.solve(y)?;
-        // v = Δχ − z on the active columns, as a coefficient of every column of U.
+        // v = Δχ − z (z on the capacitance's columns), as a coefficient of every column of U.
         let mut v = vec![0.0; self.columns.len()];
-        for ((&c, l), zj) in cap.active.iter().zip(load).zip(&z) {
-            v[c] += l - zj;
+        for (&c, l) in cap.loaded.iter().zip(load) {
+            v[c] += l;
+        }
+        for (&c, zj) in cap.active.iter().zip(&z) {
+            v[c] -= zj;
         }
         Ok(v)
     }
@@ -1168,12 +1195,38 @@ pub(super) mod tests {
         add_changes(&mut dense, &removed);
         let expected = dense
             .lu()
-            .solve(&DVector::from_vec(b))
+            .solve(&DVector::from_vec(b.clone()))
             .expect("nonsingular");
         let err = (DVector::from_vec(x) - &expected).amax() / expected.amax();
         assert!(
             err <= 1e-10,
             "relative error with the Cholesky capacitance: {err}"
+        );
+        // Contact 1's load changes alone (E = 0): it is no row of the capacitance, whose order
+        // is the other two contacts' 5 columns, and its U Δχ still reaches the solution.
+        let mut mixed = changes.clone();
+        mixed[1].stiffness = BlockCoefficients::zeros();
+        assert_eq!(low_rank.size_of(&mixed), (5, 0));
+        let cap = low_rank.capacitance(&mixed);
+        assert_eq!((cap.order(), cap.loads()), (5, 11));
+        let load = low_rank.active_load(&mixed);
+        let spread = low_rank.spread(&mixed, &load);
+        let b1: Vec<f64> = b.iter().zip(&spread).map(|(p, q)| p + q).collect();
+        let mut dense = a0_dense;
+        add_changes(&mut dense, &mixed);
+        let expected = dense
+            .lu()
+            .solve(&DVector::from_vec(b1))
+            .expect("nonsingular");
+        let mut x0 = b.clone();
+        solver.solve_in_place(&mut x0, 1).expect("solve");
+        let x1 = low_rank
+            .solve_from(solver.as_mut(), &cap, &Reference::Full(x0), &load)
+            .expect("solve");
+        let err = (DVector::from_vec(x1) - &expected).amax() / expected.amax();
+        assert!(
+            err <= 1e-10,
+            "relative error with a load-only change: {err}"
         );
     }
 }
