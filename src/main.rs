@@ -1,6 +1,7 @@
 //! The `fibercell` command line: a thin shell over the library.
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
+use fibercell::io::NetworkFormat;
 use fibercell::solve::{
     solve_incremental, solve_static, IncrementalOptions, SolveOptions, SolverKind,
 };
@@ -44,6 +45,15 @@ impl SolverArgs {
     }
 }
 
+/// `--vtk`: how VTK files are encoded.
+#[derive(Args, Clone, Copy)]
+struct VtkArgs {
+    /// Encoding of the VTK files: auto (text up to 20,000 points, base64 binary above), ascii
+    /// or binary.
+    #[arg(long = "vtk", value_name = "ENCODING", default_value = "auto", value_parser = vtk_parser())]
+    encoding: io::VtkEncoding,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Solve the linear static problem of a model (supports and nodal loads from the file).
@@ -65,6 +75,8 @@ enum Command {
         /// Directory for the results (CSV, JSON, VTK).
         #[arg(short, long, default_value = "fibercell-results")]
         output: PathBuf,
+        #[command(flatten)]
+        vtk: VtkArgs,
     },
     /// Effective stiffness of a periodic cell: ABD per unit area, the thesis's moduli and the
     /// orthotropic constants.
@@ -76,9 +88,11 @@ enum Command {
         /// Print one JSON document instead of the table.
         #[arg(long)]
         json: bool,
-        /// Also write homogenized.json and the six cell-problem solutions (case_*.vtu) here.
+        /// Also write homogenized.json and the six cell-problem solutions (case_*.vtp) here.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        #[command(flatten)]
+        vtk: VtkArgs,
     },
     /// The friction-driven elasto-plastic curve of a periodic cell with contacts: ramp a
     /// macroscopic strain (e.g. --strain e11=0.02 or --strain g12=0.01,k11=2) over --steps.
@@ -128,13 +142,15 @@ enum Command {
         #[arg(long, value_name = "PREFIX")]
         rose: Option<PathBuf>,
     },
-    /// Convert a model between formats: .toml, .json, .inp (Abaqus) in and out; .vtu and .pvd
-    /// (ParaView) out.
+    /// Convert a model between formats: .toml, .json, .inp (Abaqus) in and out; .vtp, .vtu and
+    /// .pvd (ParaView) out.
     Convert {
         /// Input model (.toml, .json or .inp).
         input: PathBuf,
-        /// Output file (.toml, .json, .inp, .vtu or .pvd).
+        /// Output file (.toml, .json, .inp, .vtp, .vtu or .pvd).
         output: PathBuf,
+        #[command(flatten)]
+        vtk: VtkArgs,
     },
     /// Throughput benchmark on generated non-woven cells: every stage timed, against the
     /// machine's measured DGEMM and memory bandwidth (see the README's performance section).
@@ -404,6 +420,18 @@ fn solver_parser() -> impl clap::builder::TypedValueParser<Value = SolverKind> {
         .try_map(|s| s.parse::<SolverKind>())
 }
 
+/// `--vtk`: the encodings' names, listed in `--help`.
+fn vtk_parser() -> impl clap::builder::TypedValueParser<Value = io::VtkEncoding> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(["auto", "ascii", "binary"]).map(|s| {
+        match s.as_str() {
+            "ascii" => io::VtkEncoding::Ascii,
+            "binary" => io::VtkEncoding::Binary,
+            _ => io::VtkEncoding::Auto,
+        }
+    })
+}
+
 /// `--ordering`: the orderings' names, listed in `--help`.
 fn ordering_parser() -> impl clap::builder::TypedValueParser<Value = Ordering> {
     use clap::builder::TypedValueParser;
@@ -496,7 +524,7 @@ fn solve(
     options: SolveOptions,
     incremental: (usize, bool),
     json: bool,
-    out: &Path,
+    (out, vtk): (&Path, io::VtkEncoding),
 ) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
     std::fs::create_dir_all(out).map_err(|e| Error::Output {
@@ -504,7 +532,7 @@ fn solve(
         message: e.to_string(),
     })?;
     if model.has_contact() {
-        return solve_with_contact(model_path, &model, options, incremental, json, out);
+        return solve_with_contact(model_path, &model, options, incremental, json, (out, vtk));
     }
     let sol = solve_static(&model, &options)?;
     let pretty = to_pretty(&io::solution_json(&model, &sol))?;
@@ -514,8 +542,8 @@ fn solve(
     )?;
     write(&out.join("displacements.json"), &pretty)?;
     write(
-        &out.join("deformed.vtu"),
-        &io::deformed_vtu(&model, &sol.displacements),
+        &out.join("network.vtp"),
+        &io::network_vtk(&model, &sol.displacements, NetworkFormat::PolyData, vtk),
     )?;
     if json {
         println!("{pretty}");
@@ -567,7 +595,7 @@ fn solve_with_contact(
     solve: SolveOptions,
     (steps, fixed_slip_direction): (usize, bool),
     json: bool,
-    out: &Path,
+    (out, vtk): (&Path, io::VtkEncoding),
 ) -> Result<(), Error> {
     let (bar, progress) = progress_bar("stick/slip");
     let opts = IncrementalOptions {
@@ -592,11 +620,11 @@ fn solve_with_contact(
     for (k, rec) in sol.increments.iter().enumerate() {
         write(
             &out.join(io::step_file("step", rec.step)),
-            &io::deformed_vtu(model, &sol.displacements[k]),
+            &io::network_vtk(model, &sol.displacements[k], NetworkFormat::PolyData, vtk),
         )?;
         write(
             &out.join(io::step_file("contacts", rec.step)),
-            &io::contacts_vtu(&sol, k),
+            &io::contacts_vtp(&sol, k, vtk),
         )?;
     }
     write(&out.join("solution.pvd"), &io::series_pvd(&sol))?;
@@ -645,7 +673,7 @@ fn homogenize(
     model_path: &Path,
     options: SolveOptions,
     json: bool,
-    out: Option<&Path>,
+    (out, vtk): (Option<&Path>, io::VtkEncoding),
 ) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
     let h = fibercell::homogenize::homogenize_elastic(&model, &options)?;
@@ -657,12 +685,20 @@ fn homogenize(
         })?;
         write(&out.join("homogenized.json"), &pretty)?;
         for (k, case) in h.cases.iter().enumerate() {
-            let name = format!("case_{}.vtu", fibercell::cell::MACRO_NAMES[k]);
-            write(&out.join(name), &io::deformed_vtu(&model, case))?;
+            let name = format!("case_{}.vtp", fibercell::cell::MACRO_NAMES[k]);
+            write(
+                &out.join(name),
+                &io::network_vtk(&model, case, NetworkFormat::PolyData, vtk),
+            )?;
         }
         write(
-            &out.join("case_pressure.vtu"),
-            &io::deformed_vtu(&model, &h.pressure.displacements),
+            &out.join("case_pressure.vtp"),
+            &io::network_vtk(
+                &model,
+                &h.pressure.displacements,
+                NetworkFormat::PolyData,
+                vtk,
+            ),
         )?;
     }
     if json {
@@ -998,9 +1034,9 @@ fn stats(model_path: &Path, json: bool, rose: Option<&Path>) -> Result<(), Error
     Ok(())
 }
 
-fn convert(input: &Path, output: &Path) -> Result<(), Error> {
+fn convert(input: &Path, output: &Path, vtk: io::VtkEncoding) -> Result<(), Error> {
     let d = io::read_description(input)?;
-    let written = io::write_model(output, &d)?;
+    let written = io::write_model(output, &d, vtk)?;
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     println!("{} → {}", input.display(), names.join(", "));
     Ok(())
@@ -1158,19 +1194,26 @@ fn main() -> ExitCode {
             fixed_slip_direction,
             json,
             output,
+            vtk,
         } => solve(
             &model,
             solver.options(),
             (steps, fixed_slip_direction),
             json,
-            &output,
+            (&output, vtk.encoding),
         ),
         Command::Homogenize {
             model,
             solver,
             json,
             output,
-        } => homogenize(&model, solver.options(), json, output.as_deref()),
+            vtk,
+        } => homogenize(
+            &model,
+            solver.options(),
+            json,
+            (output.as_deref(), vtk.encoding),
+        ),
         Command::Curve {
             model,
             strain,
@@ -1190,7 +1233,7 @@ fn main() -> ExitCode {
         ),
         Command::Generate { kind } => generate(kind),
         Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),
-        Command::Convert { input, output } => convert(&input, &output),
+        Command::Convert { input, output, vtk } => convert(&input, &output, vtk.encoding),
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
         Command::SolveMatrix {
             matrix,

@@ -26,7 +26,7 @@ fn fails_saying(args: &[&str], needle: &str) {
 }
 
 #[test]
-fn solve_writes_csv_json_vtu_and_prints_json() {
+fn solve_writes_csv_json_vtp_and_prints_json() {
     let out = tmpdir("solve");
     let o = run(&[
         "solve",
@@ -56,9 +56,12 @@ fn solve_writes_csv_json_vtu_and_prints_json() {
         serde_json::from_str(&std::fs::read_to_string(out.join("displacements.json")).unwrap())
             .unwrap();
     assert_eq!(file["displacements"], doc["displacements"]);
-    let vtu = std::fs::read_to_string(out.join("deformed.vtu")).unwrap();
+    // One poly line per fiber, reference coordinates and the displacement (7 nodes, 3 fibers).
+    let vtp = std::fs::read_to_string(out.join("network.vtp")).unwrap();
     assert!(
-        vtu.contains("NumberOfPoints=\"7\" NumberOfCells=\"6\"") && vtu.contains("Name=\"radius\"")
+        vtp.contains("NumberOfPoints=\"7\" NumberOfLines=\"3\"")
+            && vtp.contains("Name=\"radius\"")
+            && vtp.contains("Points are the reference")
     );
     // Only the three outputs, no temporary leftovers.
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 3);
@@ -186,8 +189,8 @@ fn solve_with_contact_writes_increments_contacts_and_a_vtk_series() {
         "increments.csv",
         "contacts.csv",
         "solution.pvd",
-        "step_0004.vtu",
-        "contacts_0004.vtu",
+        "step_0004.vtp",
+        "contacts_0004.vtp",
         "displacements.csv",
     ] {
         assert!(out.join(f).exists(), "{f}");
@@ -235,7 +238,7 @@ fn homogenize_prints_abd_and_writes_the_cell_problems() {
     assert!(doc["asymmetry"].as_f64().unwrap() < 1e-10);
     assert_eq!(doc["orthotropic"]["e1"], doc["abd"][0][0]);
     for k in ["e11", "e22", "g12", "k11", "k22", "k12"] {
-        assert!(out.join(format!("case_{k}.vtu")).exists());
+        assert!(out.join(format!("case_{k}.vtp")).exists());
     }
     let o = run(&["homogenize", "fixtures/ok_frame3d.toml"]);
     assert!(!o.status.success());
@@ -494,12 +497,12 @@ fn convert_round_trips_through_abaqus_and_writes_paraview_files() {
         pvd.to_str().unwrap(),
     ]);
     assert!(o.status.success());
-    let contacts = std::fs::read_to_string(out.join("cell_contacts.vtu")).unwrap();
+    let contacts = std::fs::read_to_string(out.join("cell_contacts.vtp")).unwrap();
     assert!(
         contacts.contains("NumberOfPoints=\"16\""),
         "16 closed crossings"
     );
-    assert!(std::fs::read_to_string(out.join("cell_fibers.vtu"))
+    assert!(std::fs::read_to_string(out.join("cell_fibers.vtp"))
         .unwrap()
         .contains("radius"));
     fails_saying(

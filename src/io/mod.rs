@@ -1,5 +1,5 @@
 //! Files: the native model format (TOML and JSON, one schema), Abaqus `.inp` import, results
-//! (CSV, JSON), VTK `.vtu`, Matrix Market output and plots (SVG, PNG). Outputs are written atomically.
+//! (CSV, JSON), VTK (`.vtp`, `.vtu`, `.pvd`), Matrix Market output and plots (SVG, PNG). Outputs are written atomically.
 
 mod abaqus;
 mod abaqus_cell;
@@ -27,7 +27,9 @@ pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};
 pub use results::{
     contacts_csv, displacements_csv, incremental_json, increments_csv, solution_json,
 };
-pub use vtk::{contacts_vtu, deformed_vtu, model_vtk, series_pvd, step_file};
+pub use vtk::{
+    contacts_vtp, model_vtk, network_vtk, series_pvd, step_file, NetworkFormat, VtkEncoding,
+};
 
 use crate::model::{Model, ModelDescription};
 use crate::Error;
@@ -93,10 +95,15 @@ pub fn write_description(path: &Path, d: &ModelDescription) -> Result<(), Error>
 }
 
 /// Writes a model in the format of the path's extension — `.toml`, `.json`, `.inp` (Abaqus),
-/// `.vtu` (the network with its radius) or `.pvd` (a collection of `{stem}_fibers.vtu` and
-/// `{stem}_contacts.vtu` written next to it) — validating it first; each file is written
-/// atomically. Returns the paths written.
-pub fn write_model(path: &Path, d: &ModelDescription) -> Result<Vec<std::path::PathBuf>, Error> {
+/// `.vtp` or `.vtu` (the network with its radius, see [`network_vtk`]) or `.pvd` (a
+/// collection of `{stem}_fibers.vtp` and `{stem}_contacts.vtp` written next to it) —
+/// validating it first; each file is written atomically, VTK files in `encoding`. Returns the
+/// paths written.
+pub fn write_model(
+    path: &Path,
+    d: &ModelDescription,
+    encoding: VtkEncoding,
+) -> Result<Vec<std::path::PathBuf>, Error> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -105,19 +112,27 @@ pub fn write_model(path: &Path, d: &ModelDescription) -> Result<Vec<std::path::P
     match ext.as_deref() {
         Some("toml") | Some("json") => write_description(path, d)?,
         Some("inp") => write_atomic(path, to_abaqus(d)?.as_bytes())?,
-        Some("vtu") => write_atomic(
-            path,
-            deformed_vtu(&model, &vec![[0.0; 6]; model.nodes.len()]).as_bytes(),
-        )?,
+        Some(ext @ ("vtp" | "vtu")) => {
+            let format = if ext == "vtp" {
+                NetworkFormat::PolyData
+            } else {
+                NetworkFormat::UnstructuredGrid
+            };
+            let zero = vec![[0.0; 6]; model.nodes.len()];
+            write_atomic(
+                path,
+                network_vtk(&model, &zero, format, encoding).as_bytes(),
+            )?
+        }
         Some("pvd") => {
             let stem = path
                 .file_stem()
                 .and_then(|s| s.to_str())
                 .unwrap_or("model")
                 .to_string();
-            let (network, contacts, pvd) = model_vtk(&model, &stem)?;
-            let fibers = path.with_file_name(format!("{stem}_fibers.vtu"));
-            let points = path.with_file_name(format!("{stem}_contacts.vtu"));
+            let (network, contacts, pvd) = model_vtk(&model, &stem, encoding)?;
+            let fibers = path.with_file_name(format!("{stem}_fibers.vtp"));
+            let points = path.with_file_name(format!("{stem}_contacts.vtp"));
             write_atomic(&fibers, network.as_bytes())?;
             write_atomic(&points, contacts.as_bytes())?;
             write_atomic(path, pvd.as_bytes())?;
@@ -125,7 +140,7 @@ pub fn write_model(path: &Path, d: &ModelDescription) -> Result<Vec<std::path::P
         }
         _ => {
             return Err(Error::InvalidOption(format!(
-                "{}: unknown output format (use .toml, .json, .inp, .vtu or .pvd)",
+                "{}: unknown output format (use .toml, .json, .inp, .vtp, .vtu or .pvd)",
                 path.display()
             )))
         }
