@@ -43,19 +43,10 @@ pub enum Error {
     /// The stiffness pattern does not fit the 32-bit slot map.
     #[error(transparent)]
     PatternTooLarge(#[from] crate::assembly::PatternTooLargeError),
-    /// The stick/slip iterations of an increment did not settle.
-    #[error("increment {step}: contact states still switching after {iterations} iterations ({} contact{}: {})", contacts.len(), if contacts.len() == 1 { "" } else { "s" }, contacts.iter().take(10).cloned().collect::<Vec<_>>().join("; "))]
-    ContactNotConverged {
-        /// Increment (1-based).
-        step: usize,
-        /// Iterations done.
-        iterations: usize,
-        /// The contacts that kept switching, described.
-        contacts: Vec<String>,
-    },
-    /// The state iteration of an increment settled only by holding contacts, and the held
-    /// state is not in equilibrium: the cell has a mechanism there.
-    #[error("increment {step}: no equilibrium (residual ‖R‖/‖F‖ = {residual:.1e}) with {} contact{} held in a state the contact law does not give them ({}): a fiber has lost its hold, its contacts open or sliding, so the quasi-static problem has a mechanism; bonded contacts (`--bonded`, `bonded = true` in [contact]) keep closed contacts closed, a cohesion (`cohesion` in the friction law) lets them resist sliding", held.len(), if held.len() == 1 { "" } else { "s" }, held.iter().take(10).cloned().collect::<Vec<_>>().join("; "))]
+    /// The state iteration of an increment settled only by holding contacts (that chattered, or
+    /// still changed in its last iteration), and the held state is not in equilibrium: the
+    /// cell has a mechanism there, or the increment is too large for the states to settle.
+    #[error("increment {step}: no equilibrium (residual ‖R‖/‖F‖ = {residual:.1e}) with {} contact{} held in a state the contact law does not give them, as they chattered or still changed at the last state iteration ({}): where a fiber has lost its hold, its contacts open or sliding, the quasi-static problem has a mechanism, which bonded contacts (`--bonded`, `bonded = true` in [contact]) or a cohesion (`cohesion` in the friction law) remove; otherwise smaller increments (more --steps) let the states settle", held.len(), if held.len() == 1 { "" } else { "s" }, held.iter().take(10).cloned().collect::<Vec<_>>().join("; "))]
     NoEquilibrium {
         /// Increment (1-based).
         step: usize,

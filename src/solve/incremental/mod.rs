@@ -7,8 +7,10 @@
 //!
 //! A contact that changes its state or slip direction four times within one increment (the
 //! discrete penalty problem can have no consistent state for it: e.g. closed it is pulled apart,
-//! open it penetrates) is held in its state for the rest of the increment; the count is
-//! reported per increment.
+//! open it penetrates) is held in its state for the rest of the increment; so are the contacts
+//! still changing in the last allowed iteration. The count is reported per increment, with the
+//! equilibrium residual that measures what holding them left (an error above
+//! [`MAX_HELD_RESIDUAL`]).
 //!
 //! The pattern (elements ∪ all candidate contact blocks) and each backend's symbolic analysis are
 //! built once. The first symmetric factorization is the reference: later systems are its matrix
@@ -54,6 +56,7 @@ use contact_states::ContactStates;
 use factors::Factors;
 use increment::Increment;
 use matrix_values::MatrixValues;
+use options::CHATTER_SWITCHES;
 use setup::Setup;
 
 use super::kept_contact_loads::KeptContactLoads;
@@ -232,11 +235,16 @@ impl<'a, 'h> StickSlip<'a, 'h> {
                 return self.check_equilibrium(step);
             }
             if iteration == max_iterations {
-                return Err(Error::ContactNotConverged {
-                    step,
-                    iterations: iteration,
-                    contacts: changed.iter().map(|&i| self.describe(i)).collect(),
-                });
+                // The contacts still changing are held in the states they were solved with,
+                // as chattering ones are: the equilibrium residual then says whether that is
+                // a solution (see `check_equilibrium`).
+                for &i in &changed {
+                    self.contacts.switches[i] = self.contacts.switches[i].max(CHATTER_SWITCHES);
+                }
+                let Classified { trials, .. } = self.classify();
+                inc.lap(|t| &mut t.classify);
+                self.commit(inc, iteration, &trials, report);
+                return self.check_equilibrium(step);
             }
             let direction_tol = self.setup.direction_tol;
             self.contacts.advance(

@@ -20,7 +20,8 @@ pub struct IncrementalOptions {
     pub steps: usize,
     /// Backend and checks for the symmetric systems (Coulomb sliding always uses faer LU).
     pub solve: SolveOptions,
-    /// Largest number of state iterations inside one increment.
+    /// Largest number of state iterations inside one increment (default 50); the contacts
+    /// still changing in the last are held in the states they were solved with.
     pub max_state_iterations: usize,
     /// Load factors of the increments (default: α_n = n/N, n = 1…N); any sequence, e.g. up to 1,
     /// back to 0 and up again for a load–unload–reload path. Overrides `steps`.
