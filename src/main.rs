@@ -45,6 +45,21 @@ impl SolverArgs {
     }
 }
 
+/// `-d DIR`: the directory of a command's result files (`-o` still accepted).
+#[derive(Args, Clone)]
+struct OutDir {
+    /// Directory for the result files (CSV, JSON, VTK, plots); created if missing.
+    #[arg(
+        short = 'd',
+        long = "out-dir",
+        value_name = "DIR",
+        default_value = "fibercell-results",
+        short_alias = 'o',
+        alias = "output"
+    )]
+    dir: PathBuf,
+}
+
 /// `--vtk`: how VTK files are encoded.
 #[derive(Args, Clone, Copy)]
 struct VtkArgs {
@@ -72,9 +87,8 @@ enum Command {
         /// the per-contact return mapping.
         #[arg(long)]
         fixed_slip_direction: bool,
-        /// Directory for the results (CSV, JSON, VTK).
-        #[arg(short, long, default_value = "fibercell-results")]
-        output: PathBuf,
+        #[command(flatten)]
+        output: OutDir,
         #[command(flatten)]
         vtk: VtkArgs,
     },
@@ -88,8 +102,15 @@ enum Command {
         /// Print one JSON document instead of the table.
         #[arg(long)]
         json: bool,
-        /// Also write homogenized.json and the six cell-problem solutions (case_*.vtp) here.
-        #[arg(short, long)]
+        /// Also write homogenized.json and the cell-problem solutions (case_*.vtp) to this
+        /// directory; created if missing.
+        #[arg(
+            short = 'd',
+            long = "out-dir",
+            value_name = "DIR",
+            short_alias = 'o',
+            alias = "output"
+        )]
         output: Option<PathBuf>,
         #[command(flatten)]
         vtk: VtkArgs,
@@ -113,9 +134,8 @@ enum Command {
         /// Print one JSON document.
         #[arg(long)]
         json: bool,
-        /// Directory for curve.csv, switches.csv, curve.json and curve.svg.
-        #[arg(short, long, default_value = "fibercell-results")]
-        output: PathBuf,
+        #[command(flatten)]
+        output: OutDir,
         /// Bonded contacts: closed ones never open, open ones never close; only stick and
         /// slip evolve. The same as `bonded = true` in the model's [contact], which the
         /// generated non-wovens set.
@@ -207,7 +227,7 @@ enum Command {
         /// Model file.
         model: PathBuf,
         /// Output .mtx file.
-        #[arg(short, long)]
+        #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
     },
 }
@@ -259,8 +279,8 @@ enum GenerateKind {
         /// Random seed.
         #[arg(long)]
         seed: Option<u64>,
-        /// Output model (.toml or .json).
-        #[arg(short, long)]
+        /// Output model file (.toml or .json).
+        #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
     },
     /// A plain or twill weave (see the README).
@@ -277,8 +297,8 @@ enum GenerateKind {
         /// Yarn radius (m).
         #[arg(long)]
         radius: Option<f64>,
-        /// Output model (.toml or .json).
-        #[arg(short, long)]
+        /// Output model file (.toml or .json).
+        #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
     },
     /// A geotextile: families of straight fibers with fixed junctions, in layers.
@@ -298,8 +318,8 @@ enum GenerateKind {
         /// Largest element length (m).
         #[arg(long)]
         element_length: Option<f64>,
-        /// Output model (.toml or .json).
-        #[arg(short, long)]
+        /// Output model file (.toml or .json).
+        #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
     },
     /// Any family from a catalog parameter file (`family = "woven"|"geotextile"|"knitted"|
@@ -307,8 +327,8 @@ enum GenerateKind {
     From {
         /// Parameter file (TOML).
         params: PathBuf,
-        /// Output model (.toml or .json).
-        #[arg(short, long)]
+        /// Output model file (.toml or .json).
+        #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
     },
     /// A plain-jersey knit of interlocked loops.
@@ -325,8 +345,8 @@ enum GenerateKind {
         /// Yarn radius (m).
         #[arg(long)]
         radius: Option<f64>,
-        /// Output model (.toml or .json).
-        #[arg(short, long)]
+        /// Output model file (.toml or .json).
+        #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
     },
 }
@@ -403,7 +423,7 @@ fn parse_orientation(s: &str) -> Result<fibercell::generate::Orientation, String
         Some(("vonmises", v)) => {
             let [angle, kappa] = parse_pair(v)?;
             Ok(Orientation::VonMises {
-                mean_angle: angle.to_radians(),
+                mean_angle_degrees: angle,
                 concentration: kappa,
             })
         }
@@ -738,7 +758,7 @@ fn homogenize(
     );
     let o = &h.orthotropic;
     println!(
-        "orthotropic: E1 {:.5e} N/m ({:.5e} Pa)  E2 {:.5e} N/m ({:.5e} Pa)  G12 {:.5e} N/m ({:.5e} Pa)  nu12 {:.5}  nu21 {:.5}",
+        "orthotropic: E1 {:.5e} N/m ({:.5e} Pa)  E2 {:.5e} N/m ({:.5e} Pa)  G12 {:.5e} N/m ({:.5e} Pa)\n  nu12 {:.5} (-e22/e11 under N11 = A12/A22, the thesis's nu21)  nu21 {:.5} (-e11/e22 under N22 = A12/A11, the thesis's nu12)",
         o.e1, o.e1_pa, o.e2, o.e2_pa, o.g12, o.g12_pa, o.nu12, o.nu21
     );
     let b = &h.pressure.b_hom;
@@ -882,7 +902,7 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
                 p.orientation = v;
             }
             if let Some(v) = tilt {
-                p.tilt = v.to_radians();
+                p.tilt_degrees = v;
             }
             if let Some(v) = curl {
                 p.curl = v;
@@ -1200,7 +1220,7 @@ fn main() -> ExitCode {
             solver.options(),
             (steps, fixed_slip_direction),
             json,
-            (&output, vtk.encoding),
+            (&output.dir, vtk.encoding),
         ),
         Command::Homogenize {
             model,
@@ -1229,7 +1249,7 @@ fn main() -> ExitCode {
             (strain, steps, unload),
             (solver.options(), bonded, stabilization),
             json,
-            &output,
+            &output.dir,
         ),
         Command::Generate { kind } => generate(kind),
         Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),

@@ -11,6 +11,20 @@ fn run(args: &[&str]) -> Output {
         .expect("runs")
 }
 
+/// `generate nonwoven --params PARAMS -o OUT`, which must succeed.
+fn generate_nonwoven_from(params: &Path, out: &Path) -> Output {
+    let o = run(&[
+        "generate",
+        "nonwoven",
+        "--params",
+        params.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
 fn tmpdir(name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("fibercell-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -51,7 +65,7 @@ fn solve_writes_csv_json_vtp_and_prints_json() {
     assert!(doc["solver"]["timings"]["factorize"].as_f64().is_some());
     let csv = std::fs::read_to_string(out.join("displacements.csv")).unwrap();
     assert_eq!(csv.lines().count(), 8);
-    assert!(csv.starts_with("node,ux,uy,uz,rx,ry,rz\n"));
+    assert!(csv.starts_with("node,ux [m],uy [m],uz [m],rx [rad],ry [rad],rz [rad]\n"));
     let file: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("displacements.json")).unwrap())
             .unwrap();
@@ -342,20 +356,12 @@ fn generate_nonwoven_writes_a_cell_that_stats_reads() {
         &params,
         "size = [4e-3, 4e-3]\namount = { kind = \"count\", fibers = 60 }\n\
          length = { kind = \"log_normal\", mean = 1.2e-3, cv = 0.2 }\nradius = 1e-5\n\
-         orientation = { kind = \"isotropic\" }\ntilt = 0.0\ncurl = 0.0\n\
+         orientation = { kind = \"isotropic\" }\ntilt_degrees = 0.0\ncurl = 0.0\n\
          element_length = 2e-4\ntolerance = 1e-3\nyoung = 1e9\npoisson = 0.3\nmu = 0.2\nseed = 4\n",
     )
     .unwrap();
     let from_file = out.join("from_file.json");
-    let o = run(&[
-        "generate",
-        "nonwoven",
-        "--params",
-        params.to_str().unwrap(),
-        "-o",
-        from_file.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = generate_nonwoven_from(&params, &from_file);
     assert!(String::from_utf8_lossy(&o.stdout).contains("60 fibers deposited"));
     assert!(from_file.exists());
     for (args, needle) in [
@@ -664,4 +670,134 @@ fn solve_on_a_cell_points_to_homogenize() {
             "run `fibercell homogenize`",
         );
     }
+}
+
+/// Every column of every CSV the CLI writes is a count, an id or a label, or carries its unit
+/// as `name [unit]`.
+#[test]
+fn every_csv_column_says_its_unit() {
+    const UNITLESS: [&str; 13] = [
+        "step",
+        "node",
+        "contact",
+        "fiber_a",
+        "fiber_b",
+        "state",
+        "iterations",
+        "factorizations",
+        "open",
+        "stick",
+        "slip",
+        "from",
+        "to",
+    ];
+    let out = tmpdir("units");
+    let solve = run(&[
+        "solve",
+        "fixtures/ok_contact_bars2.toml",
+        "--steps",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(solve.status.success());
+    let curve = run(&[
+        "curve",
+        "fixtures/cells/woven_small.toml",
+        "--strain",
+        "e11=0.001,k11=1",
+        "--steps",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(curve.status.success());
+    let files = [
+        "displacements.csv",
+        "increments.csv",
+        "contacts.csv",
+        "curve.csv",
+        "switches.csv",
+    ];
+    for f in files {
+        let text = std::fs::read_to_string(out.join(f)).unwrap();
+        let header = text.lines().next().unwrap();
+        for column in header.split(',') {
+            let unit = column
+                .split_once(" [")
+                .and_then(|(_, u)| u.strip_suffix(']'));
+            assert!(
+                UNITLESS.contains(&column) || unit.is_some_and(|u| !u.is_empty()),
+                "{f}: column \"{column}\" has no unit"
+            );
+        }
+    }
+    let curve_header = std::fs::read_to_string(out.join("curve.csv")).unwrap();
+    assert!(curve_header.starts_with("step,alpha [-],e11 [-],e22 [-],g12 [-],k11 [1/m]"));
+    assert!(curve_header.lines().next().unwrap().contains(",M11 [N],"));
+}
+
+/// Angles are degrees on the CLI and in parameter files alike: `--tilt 20` and
+/// `tilt_degrees = 20.0` (with von Mises `mean_angle_degrees` and `vonmises:30,2`, the other
+/// parameters the CLI's defaults) generate the same cell, and the radian-era key `tilt` is refused naming `tilt_degrees`. Results go to
+/// `-d DIR` (`--out-dir`), files to `-o FILE`.
+#[test]
+fn angles_are_degrees_and_outputs_say_dir_or_file() {
+    let out = tmpdir("degrees");
+    std::fs::create_dir_all(&out).unwrap();
+    let (cli, file) = (out.join("cli.toml"), out.join("file.toml"));
+    let o = run(&[
+        "generate",
+        "nonwoven",
+        "--fibers",
+        "30",
+        "--tilt",
+        "20",
+        "--orientation",
+        "vonmises:30,2",
+        "--seed",
+        "3",
+        "-o",
+        cli.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let params = out.join("params.toml");
+    std::fs::write(
+        &params,
+        "size = [5e-3, 5e-3]\namount = { kind = \"count\", fibers = 30 }\n\
+         length = { kind = \"fixed\", length = 2e-3 }\nradius = 1e-5\n\
+         orientation = { kind = \"von_mises\", mean_angle_degrees = 30.0, concentration = 2.0 }\n\
+         tilt_degrees = 20.0\ncurl = 0.0\nelement_length = 1e-4\ntolerance = 1e-3\n\
+         young = 1.5e9\npoisson = 0.4\nmu = 0.3\nseed = 3\n",
+    )
+    .unwrap();
+    generate_nonwoven_from(&params, &file);
+    let (a, b) = (
+        std::fs::read_to_string(&cli).unwrap(),
+        std::fs::read_to_string(&file).unwrap(),
+    );
+    assert!(a.contains("[[fibers]]") && a == b, "the two cells differ");
+    std::fs::write(&params, "tilt = 0.3\n").unwrap();
+    fails_saying(
+        &[
+            "generate",
+            "nonwoven",
+            "--params",
+            params.to_str().unwrap(),
+            "-o",
+            "x.toml",
+        ],
+        "tilt_degrees",
+    );
+    let results = out.join("results");
+    let o = run(&[
+        "homogenize",
+        "fixtures/cells/woven_small.toml",
+        "--out-dir",
+        results.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(results.join("homogenized.json").exists());
+    let help = run(&["curve", "--help"]);
+    assert!(String::from_utf8_lossy(&help.stdout).contains("-d, --out-dir <DIR>"));
 }

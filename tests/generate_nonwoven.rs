@@ -77,7 +77,7 @@ fn contacts_are_closed_and_nothing_penetrates_beyond_the_tolerance() {
     };
     // Tilted fibers rise off the mat (at least tan φ per unit length from their start).
     let tilted = NonWoven {
-        tilt: 0.05,
+        tilt_degrees: 0.05f64.to_degrees(),
         ..curled.clone()
     };
     // Flat fibers rest on the mat, none is lifted into the air: the mean coverage
@@ -108,7 +108,7 @@ fn contacts_are_closed_and_nothing_penetrates_beyond_the_tolerance() {
         assert!(
             s.z_extent < thickness_bound,
             "tilt {}: mat {} m thick",
-            p.tilt,
+            p.tilt_degrees,
             s.z_extent
         );
     }

@@ -70,7 +70,12 @@ pub enum LengthDistribution {
     },
 }
 
+/// The largest tilt a non-woven's fibers may have (degrees): steeper ones stand up out of the
+/// mat (1.5 rad before the parameter was in degrees).
+pub const MAX_TILT_DEGREES: f64 = 85.0;
+
 /// Parameters of a non-woven cell.
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NonWoven {
@@ -84,8 +89,9 @@ pub struct NonWoven {
     pub radius: f64,
     /// In-plane orientation.
     pub orientation: Orientation,
-    /// Largest tilt angle out of the plane (rad): each fiber's φ is uniform in [0, tilt].
-    pub tilt: f64,
+    /// Largest tilt angle out of the plane in degrees (as every angle of the CLI and the
+    /// parameter files): each fiber's φ is uniform in [0, tilt].
+    pub tilt_degrees: f64,
     /// In-plane curvature of the fibers (1/m), with a random sign; 0 for straight fibers. At
     /// most π / length, so a fiber turns by at most half a circle.
     pub curl: f64,
@@ -120,7 +126,7 @@ impl Default for NonWoven {
             length: LengthDistribution::Fixed { length: 2e-3 },
             radius: 1e-5,
             orientation: Orientation::Isotropic,
-            tilt: 0.0,
+            tilt_degrees: 0.0,
             curl: 0.0,
             element_length: 1e-4,
             tolerance: 1e-3,
@@ -203,10 +209,10 @@ impl NonWoven {
                 self.bond_strength
             )));
         }
-        if !(self.tilt >= 0.0 && self.tilt < 1.5) {
+        if !(self.tilt_degrees >= 0.0 && self.tilt_degrees <= MAX_TILT_DEGREES) {
             return Err(invalid(format!(
-                "non-woven tilt = {} rad must be in [0, 1.5)",
-                self.tilt
+                "non-woven tilt_degrees = {} must be in [0, {MAX_TILT_DEGREES}]",
+                self.tilt_degrees
             )));
         }
         let lmax = 0.5 * self.size[0].min(self.size[1]);
@@ -375,7 +381,7 @@ pub fn nonwoven(params: &NonWoven) -> Result<GeneratedCell, Error> {
         let start = [rng.random::<f64>() * lx, rng.random::<f64>() * ly];
         let angle = sample_angle(&mut rng, orient);
         let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
-        let tilt = params.tilt * rng.random::<f64>();
+        let tilt = params.tilt_degrees.to_radians() * rng.random::<f64>();
         if length < 4.0 * r {
             break; // the remainder of the target volume is less than a short fiber
         }

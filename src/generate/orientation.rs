@@ -13,10 +13,11 @@ use std::f64::consts::PI;
 pub enum Orientation {
     /// Uniform θ: a = I/2.
     Isotropic,
-    /// von Mises of the doubled angle about `mean_angle` (rad) with concentration κ ≥ 0.
+    /// von Mises of the doubled angle about `mean_angle_degrees` with concentration κ ≥ 0.
     VonMises {
-        /// θ₀ (rad).
-        mean_angle: f64,
+        /// θ₀ in degrees, counter-clockwise from x (as every angle of the CLI and the parameter
+        /// files).
+        mean_angle_degrees: f64,
         /// κ (0: isotropic).
         concentration: f64,
     },
@@ -66,23 +67,25 @@ pub fn concentration_for(ratio: f64) -> f64 {
 }
 
 impl Orientation {
-    /// (θ₀, κ) of the distribution; an error names the bad value.
+    /// (θ₀ in rad, κ) of the distribution; an error names the bad value.
     pub fn parameters(&self) -> Result<(f64, f64), String> {
         match *self {
             Orientation::Isotropic => Ok((0.0, 0.0)),
             Orientation::VonMises {
-                mean_angle,
+                mean_angle_degrees,
                 concentration,
             } => {
-                if !mean_angle.is_finite() {
-                    return Err(format!("orientation mean_angle {mean_angle} is not finite"));
+                if !mean_angle_degrees.is_finite() {
+                    return Err(format!(
+                        "orientation mean_angle_degrees {mean_angle_degrees} is not finite"
+                    ));
                 }
                 if !(0.0..=200.0).contains(&concentration) {
                     return Err(format!(
                         "orientation concentration {concentration} must be in [0, 200]"
                     ));
                 }
-                Ok((mean_angle, concentration))
+                Ok((mean_angle_degrees.to_radians(), concentration))
             }
             Orientation::Tensor { a11, a12 } => {
                 if !(a11.is_finite() && a12.is_finite()) {
@@ -154,7 +157,7 @@ mod tests {
             Orientation::Isotropic,
             Orientation::Tensor { a11: 0.8, a12: 0.1 },
             Orientation::VonMises {
-                mean_angle: 1.0,
+                mean_angle_degrees: 1f64.to_degrees(),
                 concentration: 2.0,
             },
         ] {
@@ -185,7 +188,7 @@ mod tests {
             .unwrap_err();
         assert!(e.contains("largest eigenvalue"), "{e}");
         let e = Orientation::VonMises {
-            mean_angle: 0.0,
+            mean_angle_degrees: 0.0,
             concentration: f64::NAN,
         }
         .parameters()

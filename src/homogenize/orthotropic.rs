@@ -29,10 +29,16 @@ pub struct Orthotropic {
     pub e1: f64,
     /// E2 = A22 − A12²/A11 (N/m).
     pub e2: f64,
-    /// ν12 = A12/A11 (the thesis's definition).
+    /// ν12 = −ε22/ε11 under a uniaxial N11 (N22 = N12 = 0) = A12/A22: the common convention
+    /// (first index the load, second the contraction; E1 ν21 = E2 ν12). The thesis calls this
+    /// ratio ν21 (see [`Orthotropic::thesis_nu21`]).
     pub nu12: f64,
-    /// ν21 = A12/A22 (the thesis's definition).
+    /// ν21 = −ε11/ε22 under a uniaxial N22 = A12/A11 (the thesis's ν12).
     pub nu21: f64,
+    /// The thesis's ν12 = A12/A11 (§5.1.2), which is [`Orthotropic::nu21`] here.
+    pub thesis_nu12: f64,
+    /// The thesis's ν21 = A12/A22, which is [`Orthotropic::nu12`] here.
+    pub thesis_nu21: f64,
     /// G12 = A66 (N/m).
     pub g12: f64,
     /// E1 / h (Pa).
@@ -67,8 +73,10 @@ impl Orthotropic {
         Orthotropic {
             e1,
             e2,
-            nu12: a12 / a11,
-            nu21: a12 / a22,
+            nu12: a12 / a22,
+            nu21: a12 / a11,
+            thesis_nu12: a12 / a11,
+            thesis_nu21: a12 / a22,
             g12: a66,
             e1_pa: e1 / thickness,
             e2_pa: e2 / thickness,
@@ -93,10 +101,36 @@ mod tests {
         abd[2][2] = 1.359719e4;
         let o = Orthotropic::from_abd(&abd, 1.0);
         // The thesis prints four digits, truncated (E1 = 415,150.8 appears as 0.4151e6).
-        assert!((o.nu12 - 0.0203).abs() < 1e-4, "{}", o.nu12);
-        assert!((o.nu21 - 0.0059).abs() < 1e-4, "{}", o.nu21);
+        assert!((o.thesis_nu12 - 0.0203).abs() < 1e-4, "{}", o.thesis_nu12);
+        assert!((o.thesis_nu21 - 0.0059).abs() < 1e-4, "{}", o.thesis_nu21);
+        assert_eq!((o.nu12, o.nu21), (o.thesis_nu21, o.thesis_nu12));
         assert!((o.e1 - 0.4151e6).abs() < 0.0001e6, "{}", o.e1);
         assert!((o.e2 - 1.4198e6).abs() < 0.0001e6, "{}", o.e2);
         assert_eq!(o.g12, 1.359719e4);
+    }
+
+    /// ν12 is the contraction −ε22/ε11 under a uniaxial N11, solved from the membrane block
+    /// (Cramer's rule on [[A11, A12], [A12, A22]] ε = (N, 0)), and E1 ν21 = E2 ν12.
+    #[test]
+    fn nu12_is_the_contraction_under_load_in_direction_1() {
+        let (a11, a22, a12) = (3.0e5, 1.2e5, 4.0e4);
+        let mut abd = [[0.0; 6]; 6];
+        abd[0][0] = a11;
+        abd[1][1] = a22;
+        abd[0][1] = a12;
+        abd[1][0] = a12;
+        abd[2][2] = 1.0e4;
+        let o = Orthotropic::from_abd(&abd, 1.0);
+        let n = 1.0;
+        let det = a11 * a22 - a12 * a12;
+        let (e11, e22) = (n * a22 / det, -n * a12 / det);
+        assert!((o.nu12 - (-e22 / e11)).abs() <= 1e-15 * o.nu12);
+        assert!(
+            (o.e1 - n / e11).abs() <= 1e-12 * o.e1,
+            "E1 = N11/ε11 under uniaxial N11"
+        );
+        assert!((o.e1 * o.nu21 - o.e2 * o.nu12).abs() <= 1e-12 * o.e1 * o.nu21);
+        // The two differ here, so the labels cannot be mixed up unnoticed.
+        assert!((o.nu12 - o.nu21).abs() > 0.1);
     }
 }

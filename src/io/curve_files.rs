@@ -14,20 +14,22 @@ use std::path::{Path, PathBuf};
 pub const RESULTANT_NAMES: [&str; 6] = ["N11", "N22", "N12", "M11", "M22", "M12"];
 /// Units of the resultants.
 pub const RESULTANT_UNITS: [&str; 6] = ["N/m", "N/m", "N/m", "N", "N", "N"];
+/// Units of the macroscopic strains and curvatures of [`MACRO_NAMES`].
+pub const STRAIN_UNITS: [&str; 6] = ["-", "-", "-", "1/m", "1/m", "1/m"];
 
 /// `curve.csv`: per increment the step, α, the strain, the resultants, their elastic and
 /// plastic parts, the open/stick/slip counts and the dissipated energy per area.
 pub fn curve_csv(c: &Curve) -> String {
-    let mut csv = String::from("step,alpha");
-    for n in MACRO_NAMES {
-        let _ = write!(csv, ",{n}");
+    let mut csv = String::from("step,alpha [-]");
+    for (n, u) in MACRO_NAMES.iter().zip(STRAIN_UNITS) {
+        let _ = write!(csv, ",{n} [{u}]");
     }
     for prefix in ["", "elastic_", "plastic_"] {
-        for r in RESULTANT_NAMES {
-            let _ = write!(csv, ",{prefix}{r}");
+        for (r, u) in RESULTANT_NAMES.iter().zip(RESULTANT_UNITS) {
+            let _ = write!(csv, ",{prefix}{r} [{u}]");
         }
     }
-    csv.push_str(",open,stick,slip,dissipated\n");
+    csv.push_str(",open,stick,slip,dissipated [J/m^2]\n");
     for pt in &c.points {
         let _ = write!(csv, "{},{}", pt.step, pt.alpha);
         for v in pt
@@ -52,11 +54,10 @@ pub fn curve_csv(c: &Curve) -> String {
 /// estimated switch strain.
 pub fn switches_csv(c: &Curve) -> String {
     let mut sw = String::from("contact,step,from,to");
-    for n in MACRO_NAMES {
-        let _ = write!(sw, ",{n}");
-    }
-    for n in MACRO_NAMES {
-        let _ = write!(sw, ",estimated_{n}");
+    for prefix in ["", "estimated_"] {
+        for (n, u) in MACRO_NAMES.iter().zip(STRAIN_UNITS) {
+            let _ = write!(sw, ",{prefix}{n} [{u}]");
+        }
     }
     sw.push('\n');
     for s in &c.switches {

@@ -18,7 +18,7 @@ pub use abaqus_export::to_abaqus;
 pub use atomic::write_atomic;
 pub use curve_files::{
     curve_csv, curve_plot, dominant_component, switches_csv, write_curve_files, RESULTANT_NAMES,
-    RESULTANT_UNITS,
+    RESULTANT_UNITS, STRAIN_UNITS,
 };
 pub use error::InputError;
 pub use matrix_market::{write_matrix_market, write_matrix_market_dense};

@@ -9,7 +9,7 @@ use std::fmt::Write;
 
 /// `node,ux,uy,uz,rx,ry,rz`, one line per node, full precision.
 pub fn displacements_csv(model: &Model, displacements: &[[f64; 6]]) -> String {
-    let mut s = String::from("node,ux,uy,uz,rx,ry,rz\n");
+    let mut s = String::from("node,ux [m],uy [m],uz [m],rx [rad],ry [rad],rz [rad]\n");
     for (n, u) in model.nodes.iter().zip(displacements) {
         let _ = writeln!(
             s,
@@ -76,7 +76,12 @@ fn side_json(model: &Model, side: ContactSide) -> Value {
 /// `step,alpha,iterations,factorizations,open,stick,slip,load_*,reaction_*`, one line per
 /// increment.
 pub fn increments_csv(sol: &IncrementalSolution) -> String {
-    let mut s = String::from("step,alpha,iterations,factorizations,open,stick,slip,load_fx,load_fy,load_fz,load_mx,load_my,load_mz,reaction_fx,reaction_fy,reaction_fz,reaction_mx,reaction_my,reaction_mz\n");
+    let mut s = String::from(
+        "step,alpha [-],iterations,factorizations,open,stick,slip,\
+         load_fx [N],load_fy [N],load_fz [N],load_mx [N*m],load_my [N*m],load_mz [N*m],\
+         reaction_fx [N],reaction_fy [N],reaction_fz [N],\
+         reaction_mx [N*m],reaction_my [N*m],reaction_mz [N*m]\n",
+    );
     for r in &sol.increments {
         let _ = write!(
             s,
@@ -95,7 +100,8 @@ pub fn increments_csv(sol: &IncrementalSolution) -> String {
 /// every contact at every increment.
 pub fn contacts_csv(sol: &IncrementalSolution) -> String {
     let mut s = String::from(
-        "step,alpha,contact,fiber_a,fiber_b,x,y,z,state,gap,normal_force,tangential_force,friction_bound\n",
+        "step,alpha [-],contact,fiber_a,fiber_b,x [m],y [m],z [m],state,gap [m],\
+         normal_force [N],tangential_force [N],friction_bound [N]\n",
     );
     for (inc, records) in sol.increments.iter().zip(&sol.contact_results) {
         for (i, (o, c)) in sol.contacts.origins.iter().zip(records).enumerate() {

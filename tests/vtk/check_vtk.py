@@ -62,7 +62,7 @@ def network_warps_to_the_deformed_frame():
     """Reference points + displacement = the solution; Warp By Vector moves them once."""
     for encoding in ["ascii", "binary"]:
         out = tmp / f"frame_{encoding}"
-        run("solve", "fixtures/ok_frame3d.toml", "-o", str(out), "--vtk", encoding)
+        run("solve", "fixtures/ok_frame3d.toml", "-d", str(out), "--vtk", encoding)
         data = read(out / "network.vtp")
         doc = json.loads((out / "displacements.json").read_text())
         assert data.GetNumberOfPoints() == 7 and data.GetNumberOfLines() == 3
@@ -144,7 +144,7 @@ def a_contact_series_reads_step_by_step():
 
 def cell_problems_read():
     out = tmp / "homogenized"
-    run("homogenize", "fixtures/cells/woven_small.toml", "-o", str(out))
+    run("homogenize", "fixtures/cells/woven_small.toml", "--out-dir", str(out))
     for case in ["e11", "e22", "g12", "k11", "k22", "k12", "pressure"]:
         data = read(out / f"case_{case}.vtp")
         assert abs(point_array(data, "displacement")).max() > 0, case
