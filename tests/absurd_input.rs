@@ -80,3 +80,163 @@ fn a_nan_length_cv_on_the_command_line_is_refused_like_in_the_file() {
     assert!(err.contains("length cv = NaN"), "{err}");
     assert!(!dir.join("S.toml").exists());
 }
+
+/// Integer parameters whose arithmetic wrapped around are refused by name: a twill of
+/// 2⁶⁴−1 over 1 passed `over + under ≤ 64` (wrapped to 0) and gave "the model is empty";
+/// 2³² × 2³² knitted loops wrapped past the 10,000-loop bound and asked for 3.3 TB; a
+/// geotextile layer of 2⁶⁴−1 panicked (index out of bounds) after `layer + 1` wrapped to 0.
+#[test]
+fn wrapping_integer_parameters_are_refused() {
+    let max = usize::MAX.to_string();
+    let twill = format!("twill:{max}/1");
+    let wales = (1u64 << 32).to_string();
+    let family = format!("0,0.001,1e-5,{max}");
+    for (args, needle) in [
+        (
+            vec!["generate", "woven", "--pattern", &twill, "-o", "x.toml"],
+            "pattern over",
+        ),
+        (
+            vec![
+                "generate",
+                "knitted",
+                "--wales",
+                &wales,
+                "--courses",
+                &wales,
+                "-o",
+                "x.toml",
+            ],
+            "at most 10,000 loops",
+        ),
+        (
+            vec![
+                "generate",
+                "geotextile",
+                "--family",
+                &family,
+                "-o",
+                "x.toml",
+            ],
+            "families[0].layer",
+        ),
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_fibercell"))
+            .args(&args)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains(needle) && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+}
+
+/// Arrays of the wrong length or with junk items are refused, naming the place: TOML's reader
+/// took `x = [2.0, 0.0, 0.0, "junk"]` as (2, 0, 0) and `size = [0.004, 0.004, 5.0]` as a
+/// 4 mm cell. JSON is held to the same.
+#[test]
+fn coordinate_arrays_must_have_their_length() {
+    let frame = std::fs::read_to_string("fixtures/ok_frame3d.toml").expect("fixture");
+    let cell = std::fs::read_to_string("fixtures/cells/woven_small.toml").expect("fixture");
+    let first_x = frame
+        .lines()
+        .find(|l| l.starts_with("x = "))
+        .expect("a node")
+        .to_string();
+    let size = cell
+        .lines()
+        .find(|l| l.starts_with("size = "))
+        .expect("a cell size")
+        .to_string();
+    for (text, needle) in [
+        (
+            frame.replacen(&first_x, "x = [2.0, 0.0, 0.0, \"junk\"]", 1),
+            "expected f64",
+        ),
+        (
+            frame.replacen(&first_x, "x = [2.0, 0.0, 0.0, 1.0]", 1),
+            "invalid length 4, expected an array of 3 numbers",
+        ),
+        (
+            frame.replacen(&first_x, "x = [2.0, 0.0]", 1),
+            "invalid length 2, expected an array of 3 numbers",
+        ),
+        (
+            cell.replacen(&size, "size = [0.004, 0.004, 5.0]", 1),
+            "invalid length 3, expected an array of 2 numbers",
+        ),
+    ] {
+        let e = fibercell::io::parse_toml(&text, "variant").expect_err("refused");
+        assert!(e.to_string().contains(needle), "{e}");
+    }
+    let json = r#"{"materials": [{"name": "m", "young": 1e9, "poisson": 0.3}],
+        "nodes": [{"id": 1, "x": [0.0, 0.0, 0.0, 9.0]}, {"id": 2, "x": [1.0, 0.0, 0.0]}],
+        "fibers": [{"id": 1, "nodes": [1, 2], "radius": 1e-4, "material": "m"}]}"#;
+    let e = fibercell::io::parse_json(json, "variant").expect_err("refused");
+    assert!(
+        e.to_string().contains("expected an array of 3 numbers"),
+        "{e}"
+    );
+}
+
+/// JSON numbers are read to the nearest f64, as TOML's are: 0.0009224032982700329 came in one
+/// ulp low (…328), so TOML → JSON → TOML changed 1,730 of the M cell's 7,344 coordinates.
+#[test]
+fn json_numbers_round_trip_exactly() {
+    let text = "0.0009224032982700329";
+    let json = format!(
+        r#"{{"materials": [{{"name": "m", "young": 1e9, "poisson": 0.3}}],
+        "nodes": [{{"id": 1, "x": [{text}, 0.0, 0.0]}}, {{"id": 2, "x": [1.0, 0.0, 0.0]}}],
+        "fibers": [{{"id": 1, "nodes": [1, 2], "radius": 1e-4, "material": "m"}}]}}"#
+    );
+    let d = fibercell::io::parse_json(&json, "variant").expect("valid");
+    let want: f64 = text.parse().expect("a number");
+    assert_eq!(d.nodes[0].x[0].to_bits(), want.to_bits());
+    // And a whole generated cell survives TOML → JSON → TOML bit for bit.
+    let cell = fibercell::generate::nonwoven(
+        &fibercell::generate::nonwoven_preset("S", 1).expect("preset"),
+    )
+    .expect("cell")
+    .description;
+    let json = fibercell::io::to_json(&cell).expect("json");
+    let back = fibercell::io::parse_json(&json, "round trip").expect("reads");
+    assert_eq!(back, cell);
+}
+
+/// A curve of e11 = 10¹⁰ ran and printed N11 = 3.9·10¹¹ N/m from a geometrically linear model;
+/// strains beyond MAX_MACRO_STRAIN (curvatures times the period) are refused by name.
+#[test]
+fn strains_beyond_small_strain_theory_are_refused() {
+    let model = load_model(Path::new("fixtures/cells/woven_small.toml")).expect("fixture");
+    let period = model
+        .cell
+        .as_ref()
+        .map_or(0.0, |c| c.size[0].max(c.size[1]));
+    let run = |strain: [f64; 6]| {
+        elasto_plastic_curve(
+            &model,
+            &CurveOptions {
+                strain,
+                steps: 2,
+                unload: false,
+                incremental: IncrementalOptions::default(),
+            },
+        )
+    };
+    let e = run([1e10, 0.0, 0.0, 0.0, 0.0, 0.0])
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        e.contains("e11") && e.contains("geometrically linear"),
+        "{e}"
+    );
+    let k = 1.01 * fibercell::homogenize::MAX_MACRO_STRAIN / period;
+    let e = run([0.0, 0.0, 0.0, 0.0, k, 0.0])
+        .expect_err("refused")
+        .to_string();
+    assert!(e.contains("k22"), "{e}");
+    assert!(run([0.001, 0.0, 0.0, 0.0, 0.0, 0.0]).is_ok());
+}

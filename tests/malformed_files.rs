@@ -147,7 +147,7 @@ fn unknown_keywords_and_keys_name_what_is_unknown() {
         (
             parse_toml as Parser,
             "[cell]\nsize = [1.0]\n",
-            "length 2",
+            "an array of 2 numbers",
             2,
         ),
         (

@@ -55,6 +55,7 @@ pub enum LayerJunction {
 #[serde(deny_unknown_fields)]
 pub struct Geotextile {
     /// Cell periods (L_x, L_y) (m).
+    #[serde(deserialize_with = "crate::model::fixed_array::exactly")]
     pub size: [f64; 2],
     /// Fiber families (at least one; a layer with one family only must be joined to another).
     pub families: Vec<FiberFamily>,
@@ -118,6 +119,16 @@ impl Geotextile {
             return Err(invalid("geotextile: no fiber families".into()));
         }
         for (k, f) in self.families.iter().enumerate() {
+            // Layers are numbered from 0 without gaps (checked below), so a layer is below the
+            // number of families; `layer + 1` of a huge one would wrap around.
+            if f.layer >= self.families.len() {
+                return Err(invalid(format!(
+                    "geotextile: families[{k}].layer = {} but there are {} families: layers are \
+                     numbered 0, 1, … without gaps",
+                    f.layer,
+                    self.families.len()
+                )));
+            }
             positive(&format!("families[{k}].spacing"), f.spacing)?;
             positive(&format!("families[{k}].radius"), f.radius)?;
             if !f.angle_degrees.is_finite() || !f.offset.unwrap_or(0.0).is_finite() {

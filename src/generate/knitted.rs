@@ -84,7 +84,8 @@ impl Knit {
             positive("knitted", name, v)?;
         }
         material("knitted", self.poisson, self.mu)?;
-        if self.wales == 0 || self.courses == 0 || self.wales * self.courses > 10_000 {
+        let loops = self.wales.checked_mul(self.courses);
+        if self.wales == 0 || self.courses == 0 || loops.is_none_or(|n| n > 10_000) {
             return Err(invalid(format!(
                 "knitted: wales = {}, courses = {}: both ≥ 1, at most 10,000 loops",
                 self.wales, self.courses

@@ -80,6 +80,7 @@ pub const MAX_TILT_DEGREES: f64 = 85.0;
 #[serde(deny_unknown_fields)]
 pub struct NonWoven {
     /// Cell periods (L_x, L_y) (m).
+    #[serde(deserialize_with = "crate::model::fixed_array::exactly")]
     pub size: [f64; 2],
     /// How many fibers.
     pub amount: FiberAmount,

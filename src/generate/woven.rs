@@ -60,6 +60,7 @@ pub struct Weave {
     /// Interlacing pattern.
     pub pattern: WeavePattern,
     /// Cell size (L_x, L_y) (m): one repeat of the pattern.
+    #[serde(deserialize_with = "crate::model::fixed_array::exactly")]
     pub size: [f64; 2],
     /// Yarn radius r (m); the undulation amplitude is r, so crossing yarns touch.
     pub radius: f64,
@@ -116,7 +117,8 @@ impl Weave {
             )));
         }
         let (o, u) = self.pattern.floats();
-        if o == 0 || u == 0 || o + u > 64 {
+        // Each bound first: o + u of huge floats would wrap around.
+        if o == 0 || u == 0 || o > 64 || u > 64 || o + u > 64 {
             return Err(invalid(format!(
                 "woven: pattern over {o}, under {u}: both must be ≥ 1 (and the repeat ≤ 64)"
             )));

@@ -111,6 +111,29 @@ pub struct Curve {
     pub solution: IncrementalSolution,
 }
 
+/// The largest macroscopic strain (and curvature times the cell's larger period) a curve takes:
+/// the beams and contacts are geometrically linear, so far beyond this the answer is that of
+/// a different model.
+pub const MAX_MACRO_STRAIN: f64 = 0.5;
+
+/// Refuses strains beyond [`MAX_MACRO_STRAIN`] (curvatures times the larger period).
+fn check_small_strain(model: &Model, strain: &[f64; 6]) -> Result<(), Error> {
+    let period = model
+        .cell
+        .as_ref()
+        .map_or(1.0, |c| c.size[0].max(c.size[1]));
+    for (k, (&e, name)) in strain.iter().zip(crate::cell::MACRO_NAMES).enumerate() {
+        let measure = if k < 3 { e.abs() } else { e.abs() * period };
+        if measure > MAX_MACRO_STRAIN {
+            return Err(Error::InvalidOption(format!(
+                "{name} = {e}: the model is geometrically linear (small strains); strains and \
+                 curvatures times the period ({period} m) must stay within {MAX_MACRO_STRAIN}"
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Ramps the macroscopic strain of a periodic cell with contacts along `opts`.
 pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve, Error> {
     if let Some(v) = opts.strain.iter().find(|v| !v.is_finite()) {
@@ -123,6 +146,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             "the number of increments must be at least 1".into(),
         ));
     }
+    check_small_strain(model, &opts.strain)?;
     let path_length = if opts.unload { 3 } else { 1 };
     if opts.steps > crate::solve::MAX_INCREMENTS / path_length {
         return Err(Error::InvalidOption(format!(

@@ -11,7 +11,9 @@ mod pressure;
 mod segments;
 pub(crate) mod system;
 
-pub use curve::{elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEvent};
+pub use curve::{
+    elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEvent, MAX_MACRO_STRAIN,
+};
 pub use elastic::{
     cell_problem, elastic_abd, homogenize_elastic, HomogenizeTimings, Homogenized, LinearSystem,
     PressureResponse,

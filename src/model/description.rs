@@ -60,6 +60,7 @@ pub struct NodeSpec {
     /// Node id (any unsigned integer, unique).
     pub id: u64,
     /// Coordinates x, y, z (m).
+    #[serde(deserialize_with = "super::fixed_array::exactly")]
     pub x: [f64; 3],
 }
 
@@ -98,10 +99,10 @@ pub struct LoadSpec {
     /// Node id.
     pub node: u64,
     /// Force (N).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::fixed_array::exactly")]
     pub force: [f64; 3],
     /// Moment (N·m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::fixed_array::exactly")]
     pub moment: [f64; 3],
 }
 
@@ -201,7 +202,11 @@ pub struct ContactPairSpec {
     /// Side II.
     pub b: SideSpec,
     /// Unit normal from I to II (default: from the position of I to that of II).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::fixed_array::optional"
+    )]
     pub normal: Option<[f64; 3]>,
     /// Initial gap ḡ (m; default 0: touching).
     #[serde(default)]
@@ -244,9 +249,14 @@ pub enum SideSpec {
 #[serde(deny_unknown_fields)]
 pub struct CellSpec {
     /// Periods L_x, L_y (m).
+    #[serde(deserialize_with = "super::fixed_array::exactly")]
     pub size: [f64; 2],
     /// Lower-left corner (x₀, y₀) of the cell (m; default: the smallest node coordinates).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::fixed_array::optional"
+    )]
     pub origin: Option<[f64; 2]>,
     /// Thickness h used to turn stress resultants into moduli in Pa (m; default: the z extent
     /// of the fiber surfaces).

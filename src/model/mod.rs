@@ -6,6 +6,7 @@ mod contact_side;
 mod description;
 mod dof;
 mod error;
+pub(crate) mod fixed_array;
 mod friction;
 mod material;
 mod network;
