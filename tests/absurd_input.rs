@@ -240,3 +240,33 @@ fn strains_beyond_small_strain_theory_are_refused() {
     assert!(e.contains("k22"), "{e}");
     assert!(run([0.001, 0.0, 0.0, 0.0, 0.0, 0.0]).is_ok());
 }
+
+/// A periodic cell with `[[loads]]` homogenized and ran its curve as if they were not there,
+/// and a fiber of radius 1 cm in a 4 mm cell gave an answer; both are refused with the reason.
+#[test]
+fn a_cell_refuses_nodal_loads_and_fibers_thicker_than_a_period() {
+    let cell = std::fs::read_to_string("fixtures/cells/woven_small.toml").expect("fixture");
+    let at = cell.find("[cell]").expect("a cell");
+    let loaded = format!(
+        "{}[[loads]]\nnode = 1\nforce = [1.0, 0.0, 0.0]\n\n{}",
+        &cell[..at],
+        &cell[at..]
+    );
+    let d = fibercell::io::parse_toml(&loaded, "loaded").expect("parses");
+    let e = fibercell::Model::from_description(&d)
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        e.contains("[[loads]] at node 1") && e.contains("macroscopic"),
+        "{e}"
+    );
+    let mut d = fibercell::io::parse_toml(&cell, "thick").expect("parses");
+    let period = d.cell.as_ref().map_or(0.0, |c| c.size[0].min(c.size[1]));
+    d.fibers[0].radius = 0.5 * period;
+    let e = fibercell::Model::from_description(&d)
+        .expect_err("refused")
+        .to_string();
+    assert!(e.contains("its own periodic image"), "{e}");
+    d.fibers[0].radius = 0.49 * period;
+    assert!(fibercell::Model::from_description(&d).is_ok());
+}

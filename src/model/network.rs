@@ -160,6 +160,31 @@ fn check_cell(c: &super::CellSpec) -> Result<(), ModelError> {
     Ok(())
 }
 
+/// What a periodic cell cannot hold: nodal loads (it is driven by the macroscopic strains,
+/// and they would be ignored) and fibers as thick as a period (a fiber would overlap its own
+/// periodic image).
+fn check_cell_contents(c: &super::CellSpec, d: &ModelDescription) -> Result<(), ModelError> {
+    if let Some(l) = d.loads.first() {
+        return Err(ModelError::InvalidCell(format!(
+            "[[loads]] at node {} (and {} more): a periodic cell is loaded by macroscopic \
+             strains (`fibercell curve --strain …`) and its effective stiffness is its response \
+             to them (`homogenize`); nodal loads would be ignored, so remove them",
+            l.node,
+            d.loads.len() - 1
+        )));
+    }
+    let period = c.size[0].min(c.size[1]);
+    if let Some(f) = d.fibers.iter().find(|f| 2.0 * f.radius >= period) {
+        return Err(ModelError::InvalidCell(format!(
+            "fiber {} has the diameter {} m, not below the cell's shorter period {period} m: it \
+             would overlap its own periodic image (radius in m, e.g. 1e-5 for 10 µm)",
+            f.id,
+            2.0 * f.radius
+        )));
+    }
+    Ok(())
+}
+
 impl Model {
     /// Validates a description and builds the model. Every failure names the item.
     pub fn from_description(d: &ModelDescription) -> Result<Model, ModelError> {
@@ -376,6 +401,7 @@ impl Model {
         }
         if let Some(c) = &d.cell {
             check_cell(c)?;
+            check_cell_contents(c, d)?;
         }
         Ok(Model {
             name: d.name.clone(),
