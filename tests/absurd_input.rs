@@ -270,3 +270,23 @@ fn a_cell_refuses_nodal_loads_and_fibers_thicker_than_a_period() {
     d.fibers[0].radius = 0.49 * period;
     assert!(fibercell::Model::from_description(&d).is_ok());
 }
+
+/// An Abaqus n1 direction of `nan, 0, 1` or one parallel to an element of its section was
+/// accepted (the README said it is checked); both are refused at their line. The frame's own
+/// n1, (0.6, 0.48, 0.64), is across all four directions of its bent fiber.
+#[test]
+fn an_abaqus_n1_must_be_finite_and_across_the_beam() {
+    let text = std::fs::read_to_string("fixtures/ok_frame3d.inp").expect("fixture");
+    assert!(fibercell::io::parse_abaqus(&text, "frame").is_ok());
+    for (n1, needle) in [
+        ("nan, 0.0, 1.0", "must be finite and nonzero"),
+        ("0.0, 0.0, 0.0", "must be finite and nonzero"),
+        ("0.0, 0.0, -1.0", "parallel to element 1"),
+        ("1.0, 0.0, 0.0", "parallel to element 3"),
+    ] {
+        let bad = text.replacen("0.6, 0.48, 0.64", n1, 1);
+        let e = fibercell::io::parse_abaqus(&bad, "frame").expect_err("refused");
+        assert!(e.to_string().contains(needle), "{n1}: {e}");
+        assert!(e.to_string().contains(":27:"), "{n1}: {e}");
+    }
+}

@@ -21,6 +21,8 @@ struct Section {
     material: String,
     radius: Option<f64>,
     line: usize,
+    /// The n1 direction line and where it is.
+    n1: Option<([f64; 3], usize)>,
 }
 
 #[derive(Default)]
@@ -250,10 +252,21 @@ impl Reader {
                 return Ok(Block::BeamSectionDirection);
             }
             Block::BeamSectionDirection => {
-                // n1 direction: checked, then irrelevant for a circular section.
+                // n1 direction: checked (here, and against the elements once they are known),
+                // then irrelevant for a circular section.
                 need(3, "beam section direction")?;
-                for f in &fields[..3] {
-                    self.num(line, f, "direction")?;
+                let mut n1 = [0.0; 3];
+                for (v, f) in n1.iter_mut().zip(&fields[..3]) {
+                    *v = self.num(line, f, "direction")?;
+                }
+                if !n1.iter().all(|v| v.is_finite()) || n1.iter().all(|&v| v == 0.0) {
+                    return Err(self.err(
+                        line,
+                        format!("beam section direction n1 = {n1:?} must be finite and nonzero"),
+                    ));
+                }
+                if let Some(s) = self.sections.last_mut() {
+                    s.n1 = Some((n1, line));
                 }
                 return Ok(Block::None);
             }
@@ -479,6 +492,7 @@ impl Reader {
                     material: material.to_ascii_uppercase(),
                     radius: None,
                     line,
+                    n1: None,
                 });
                 Block::BeamSection
             }
@@ -541,6 +555,29 @@ struct Context {
 
 /// Splits the elements of one section into polylines: chains through nodes that join exactly
 /// two of them. Returns node-id lists with the id of each chain's first element.
+/// A section's n1 must not be parallel to any of its elements (`elements`: id and nodes),
+/// which Abaqus refuses: it then defines no cross-section plane.
+fn check_n1(
+    coordinates: &HashMap<u64, [f64; 3]>,
+    elements: &[(u64, u64, u64)],
+    n1: [f64; 3],
+) -> Result<(), String> {
+    let n = nalgebra::Vector3::from(n1);
+    for &(id, a, b) in elements {
+        let (Some(xa), Some(xb)) = (coordinates.get(&a), coordinates.get(&b)) else {
+            continue; // unknown nodes are reported where the fibers are built
+        };
+        let axis = nalgebra::Vector3::from(*xb) - nalgebra::Vector3::from(*xa);
+        if axis.cross(&n).norm() <= 1e-9 * axis.norm() * n.norm() {
+            return Err(format!(
+                "beam section direction n1 = {n1:?} is parallel to element {id}: it must \
+                 point across the beam (any direction not along it, e.g. a coordinate axis)"
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn chain(elements: &[(u64, u64, u64)]) -> Vec<(u64, Vec<u64>)> {
     let mut at: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
     for (k, &(_, a, b)) in elements.iter().enumerate() {
@@ -624,6 +661,7 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
     };
     // Sections → fibers.
     let by_id: HashMap<u64, (u64, u64, u64)> = r.elements.iter().map(|e| (e.0, *e)).collect();
+    let coordinates: HashMap<u64, [f64; 3]> = r.nodes.iter().map(|n| (n.id, n.x)).collect();
     let mut owner: HashMap<u64, usize> = HashMap::new();
     let mut fibers = Vec::new();
     let materials: HashMap<String, String> = r
@@ -666,6 +704,9 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
                 continue;
             }
             els.push(*e);
+        }
+        if let Some((n1, line)) = s.n1 {
+            check_n1(&coordinates, &els, n1).map_err(|m| path_err(line, m))?;
         }
         let chains = chain(&els);
         // A section of its own per fiber (`FIBER-<id>`, as fibercell writes) keeps the fiber id.

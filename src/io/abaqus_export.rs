@@ -153,24 +153,44 @@ fn dof_ranges(sets: &[DofSet]) -> Vec<(usize, usize)> {
         .collect()
 }
 
-/// The coordinate axis least aligned with every element of the fiber.
+/// The direction least aligned with every element of the fiber, among the three coordinate
+/// axes and the ten diagonals (normalized ±1 combinations): its largest |cos| to an element
+/// is the smallest. A fiber bent along all three axes (up, across, along y) has every axis
+/// parallel to some element, and Abaqus refuses an n1 along an element; a diagonal then serves.
 fn section_direction(model: &Model, f: &crate::model::FiberSpec) -> [f64; 3] {
     let pos = |id: u64| model.node_index(id).map_or([0.0; 3], |i| model.nodes[i].x);
-    let mut worst = [0.0f64; 3];
-    for pair in f.nodes.windows(2) {
-        let (a, b) = (pos(pair[0]), pos(pair[1]));
-        let t = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let l = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
-        for k in 0..3 {
-            worst[k] = worst[k].max((t[k] / l).abs());
+    let axes: Vec<[f64; 3]> = f
+        .nodes
+        .windows(2)
+        .filter_map(|pair| {
+            let (a, b) = (pos(pair[0]), pos(pair[1]));
+            let t = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let l = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+            (l > 0.0).then(|| t.map(|v| v / l))
+        })
+        .collect();
+    let mut candidates: Vec<[f64; 3]> = vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let (r2, r3) = (0.5f64.sqrt(), (1.0f64 / 3.0).sqrt());
+    for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+        for sign in [1.0, -1.0] {
+            let mut d = [0.0; 3];
+            d[i] = r2;
+            d[j] = sign * r2;
+            candidates.push(d);
         }
     }
-    let k = (0..3)
-        .min_by(|&a, &b| worst[a].total_cmp(&worst[b]))
-        .unwrap_or(2);
-    let mut n1 = [0.0; 3];
-    n1[k] = 1.0;
-    n1
+    for (sy, sz) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+        candidates.push([r3, sy * r3, sz * r3]);
+    }
+    let alignment = |d: &[f64; 3]| {
+        axes.iter()
+            .map(|t| (t[0] * d[0] + t[1] * d[1] + t[2] * d[2]).abs())
+            .fold(0.0f64, f64::max)
+    };
+    candidates
+        .into_iter()
+        .min_by(|a, b| alignment(a).total_cmp(&alignment(b)))
+        .unwrap_or([0.0, 0.0, 1.0])
 }
 
 /// The periodic pairing as TexGen-style `*EQUATION`s with three driver nodes.
