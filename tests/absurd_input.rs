@@ -290,3 +290,24 @@ fn an_abaqus_n1_must_be_finite_and_across_the_beam() {
         assert!(e.to_string().contains(":27:"), "{n1}: {e}");
     }
 }
+
+/// 512 bytes of `.inp`, twelve `GENERATE` sets of 10⁸ ids each, took 10 GB and 34 s (the cap
+/// was per set); the cap is now on all sets together, and the error comes at once.
+#[test]
+fn generated_sets_are_capped_in_total() {
+    let mut text = String::from("*Node\n1, 0, 0, 0\n");
+    for k in 0..12 {
+        text.push_str(&format!("*Nset, nset=S{k}, generate\n1, 100000000, 1\n"));
+    }
+    let e = fibercell::io::parse_abaqus(&text, "sets").expect_err("refused");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("GENERATE sets of more than") && msg.contains(":4:"),
+        "{msg}"
+    );
+    // Two sets within the total are fine.
+    let ok = "*Node\n1, 0, 0, 0\n*Nset, nset=A, generate\n1, 4000000, 1\n\
+              *Nset, nset=B, generate\n1, 4000000, 1\n";
+    assert!(fibercell::io::parse_abaqus(ok, "sets").is_ok());
+    const { assert!(fibercell::io::MAX_GENERATED_MEMBERS >= 8_000_000) };
+}

@@ -13,7 +13,7 @@ mod plot;
 mod results;
 mod vtk;
 
-pub use abaqus::parse_abaqus;
+pub use abaqus::{parse_abaqus, MAX_GENERATED_MEMBERS};
 pub use abaqus_export::to_abaqus;
 pub use atomic::write_atomic;
 pub use curve_files::{
