@@ -311,3 +311,26 @@ fn generated_sets_are_capped_in_total() {
     assert!(fibercell::io::parse_abaqus(ok, "sets").is_ok());
     const { assert!(fibercell::io::MAX_GENERATED_MEMBERS >= 8_000_000) };
 }
+
+/// `generate nonwoven --volume-fraction 0.99` ran for minutes without a word (the mat piles up
+/// far beyond its thickness) and `--fibers 10000000` grew past 5 GB: both are refused before
+/// anything is deposited, with the bound and what to change.
+#[test]
+fn nonwovens_that_cannot_be_built_are_refused_up_front() {
+    use fibercell::generate::{nonwoven, FiberAmount, NonWoven, MAX_ELEMENTS, MAX_VOLUME_FRACTION};
+    let dense = NonWoven {
+        amount: FiberAmount::VolumeFraction {
+            fraction: 0.99,
+            thickness: 1e-4,
+        },
+        ..NonWoven::default()
+    };
+    let e = nonwoven(&dense).expect_err("refused").to_string();
+    assert!(e.contains(&format!("(0, {MAX_VOLUME_FRACTION}]")), "{e}");
+    let many = NonWoven {
+        amount: FiberAmount::Count { fibers: 10_000_000 },
+        ..NonWoven::default()
+    };
+    let e = nonwoven(&many).expect_err("refused").to_string();
+    assert!(e.contains(&format!("at most {MAX_ELEMENTS}")), "{e}");
+}

@@ -17,7 +17,7 @@ pub use grid::{clamped_grid, crossing_grid};
 pub use knitted::{knitted, Knit};
 pub use nonwoven::{
     nonwoven, nonwoven_preset, DepositionReport, FiberAmount, GeneratedCell, LengthDistribution,
-    NonWoven,
+    NonWoven, MAX_ELEMENTS, MAX_TILT_DEGREES, MAX_VOLUME_FRACTION,
 };
 pub use orientation::{bessel_ratio, concentration_for, sample_angle, Orientation};
 pub use woven::{weave, Weave, WeavePattern};

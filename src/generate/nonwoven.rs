@@ -70,6 +70,12 @@ pub enum LengthDistribution {
     },
 }
 
+/// The largest solid volume fraction a non-woven may be asked for.
+pub const MAX_VOLUME_FRACTION: f64 = 0.5;
+
+/// The most elements a generated non-woven may have (13 times the L preset's).
+pub const MAX_ELEMENTS: usize = 2_000_000;
+
 /// The largest tilt a non-woven's fibers may have (degrees): steeper ones stand up out of the
 /// mat (1.5 rad before the parameter was in degrees).
 pub const MAX_TILT_DEGREES: f64 = 85.0;
@@ -254,31 +260,36 @@ impl NonWoven {
                 self.element_length
             )));
         }
-        match self.amount {
-            FiberAmount::Count { fibers } if fibers == 0 || fibers > 10_000_000 => {
-                return Err(invalid(format!(
-                    "non-woven fiber count {fibers} must be in 1..=10⁷"
-                )))
+        let fibers = match self.amount {
+            FiberAmount::Count { fibers: 0 } => {
+                return Err(invalid("non-woven fiber count 0 must be at least 1".into()))
             }
+            FiberAmount::Count { fibers } => fibers as f64,
             FiberAmount::VolumeFraction {
                 fraction,
                 thickness,
             } => {
-                if !(fraction > 0.0 && fraction < 1.0) {
+                if !(fraction > 0.0 && fraction <= MAX_VOLUME_FRACTION) {
                     return Err(invalid(format!(
-                        "non-woven volume fraction {fraction} must be in (0, 1)"
+                        "non-woven volume fraction {fraction} must be in (0, \
+                         {MAX_VOLUME_FRACTION}]: fibers deposited one on another cannot fill \
+                         more (at 0.5 in 0.1 mm they already pile up 20 mm high)"
                     )));
                 }
                 positive("thickness", thickness)?;
                 let volume = fraction * self.size[0] * self.size[1] * thickness;
-                let per_fiber = std::f64::consts::PI * self.radius.powi(2) * mean;
-                if volume / per_fiber > 1e7 {
-                    return Err(invalid(
-                        "non-woven volume fraction needs more than 10⁷ fibers".into(),
-                    ));
-                }
+                volume / (std::f64::consts::PI * self.radius.powi(2) * mean)
             }
-            _ => {}
+        };
+        // The model's size, before anything is deposited: 10⁷ fibers grew past 5 GB.
+        let elements = fibers * (mean / self.element_length).ceil().max(1.0);
+        if !(elements <= MAX_ELEMENTS as f64) {
+            return Err(invalid(format!(
+                "non-woven of {fibers:.0} fibers of about {:.0} elements each: {elements:.2e} \
+                 elements, at most {MAX_ELEMENTS} (the L preset has 1.5·10⁵); use fewer or \
+                 shorter fibers, a larger element_length or a smaller cell",
+                (mean / self.element_length).ceil()
+            )));
         }
         self.orientation.parameters().map_err(invalid)?;
         Ok(())
