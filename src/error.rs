@@ -58,6 +58,15 @@ pub enum Error {
     /// An option is out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// The solution is not finite although every input is: loads or prescribed values so
+    /// large that the displacements overflow.
+    #[error("{context}: the solution overflows (the largest load or prescribed value is {largest:e}): the displacements are beyond floating point; use smaller loads or other units")]
+    NonFiniteSolution {
+        /// Where (the static solve, an increment).
+        context: String,
+        /// The largest applied load or prescribed value.
+        largest: f64,
+    },
     /// Writing an output failed.
     #[error("cannot write {path}: {message}")]
     Output {

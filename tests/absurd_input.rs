@@ -334,3 +334,39 @@ fn nonwovens_that_cannot_be_built_are_refused_up_front() {
     let e = nonwoven(&many).expect_err("refused").to_string();
     assert!(e.contains(&format!("at most {MAX_ELEMENTS}")), "{e}");
 }
+
+/// 10³⁰⁸ as a coordinate was reported as a "zero-length element", as a radius as "non-finite
+/// value at index 0" of the matrix (no item), and as a load it gave a displacement of inf m
+/// with residual 0: each now names its item and the real cause.
+#[test]
+fn huge_numbers_are_named_where_they_are() {
+    let frame = std::fs::read_to_string("fixtures/ok_frame3d.toml").expect("fixture");
+    let read = |text: &str| {
+        let d = fibercell::io::parse_toml(text, "huge").expect("parses");
+        fibercell::Model::from_description(&d)
+            .expect_err("refused")
+            .to_string()
+    };
+    let coordinate = frame.replacen("x = [0.0, 0.0, 0.0]", "x = [1e308, 0.0, 0.0]", 1);
+    let e = read(&coordinate);
+    assert!(e.contains("node 1 has the coordinates [1e308"), "{e}");
+    let radius = frame
+        .lines()
+        .find(|l| l.starts_with("radius"))
+        .expect("a radius");
+    let e = read(&frame.replacen(radius, "radius = 1e308", 1));
+    assert!(
+        e.contains("invalid radius 1e308") && e.contains("E·πr⁴/4"),
+        "{e}"
+    );
+    let force = frame
+        .lines()
+        .find(|l| l.starts_with("force"))
+        .expect("a load");
+    let e = read(&frame.replacen(force, "force = [1e308, 0.0, 0.0]", 1));
+    assert!(e.contains("load at node") && e.contains("1e100"), "{e}");
+    // Within the bounds the model is accepted.
+    let d = fibercell::io::parse_toml(&frame.replacen(force, "force = [1e99, 0.0, 0.0]", 1), "ok")
+        .expect("parses");
+    assert!(fibercell::Model::from_description(&d).is_ok());
+}

@@ -17,8 +17,8 @@ pub enum ModelError {
     /// Two materials share a name.
     #[error("material \"{0}\" is defined twice")]
     DuplicateMaterial(String),
-    /// A coordinate is NaN or infinite.
-    #[error("node {node} has a non-finite coordinate {coordinate:?}")]
+    /// A coordinate is NaN, infinite or beyond [`MAX_COORDINATE`](crate::model::MAX_COORDINATE).
+    #[error("node {node} has the coordinates [{:e}, {:e}, {:e}]: each must be finite and within ±{:e} m (lengths and stiffnesses computed from larger ones overflow)", coordinate[0], coordinate[1], coordinate[2], crate::model::MAX_COORDINATE)]
     NonFiniteCoordinate {
         /// Node id.
         node: u64,
@@ -66,8 +66,8 @@ pub enum ModelError {
         /// Fiber of the second occurrence.
         fiber_b: u64,
     },
-    /// r ≤ 0 or not finite.
-    #[error("fiber {fiber} has an invalid radius {radius} (must be finite and > 0)")]
+    /// r ≤ 0, not finite, or so large that the section stiffness E·πr⁴/4 overflows.
+    #[error("fiber {fiber} has an invalid radius {radius:e} m (must be finite and > 0, and its section stiffness E·πr⁴/4 finite)")]
     InvalidRadius {
         /// Fiber id.
         fiber: u64,
@@ -92,8 +92,8 @@ pub enum ModelError {
     /// A node that no fiber uses.
     #[error("node {0} belongs to no fiber")]
     UnusedNode(u64),
-    /// A NaN or infinite load or prescribed value.
-    #[error("{what} at node {node} is not finite")]
+    /// A NaN, infinite or absurdly large (beyond ±1e100) load or prescribed value.
+    #[error("{what} at node {node} is not finite or beyond ±1e100 (its norms and the displacements it causes would overflow)")]
     NonFiniteValue {
         /// Node id.
         node: u64,

@@ -22,5 +22,5 @@ pub use dof::{Dof, DofSet};
 pub use error::ModelError;
 pub use friction::Friction;
 pub use material::Material;
-pub use network::{Element, Fiber, Load, Model, Node, Support};
+pub use network::{Element, Fiber, Load, Model, Node, Support, MAX_COORDINATE, MAX_LOAD};
 pub use section::Section;

@@ -134,6 +134,14 @@ fn bounding_diagonal(nodes: &[Node]) -> f64 {
     (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
 }
 
+/// The largest coordinate (and prescribed displacement) magnitude a model may have (m):
+/// squared lengths of elements between such nodes stay finite.
+pub const MAX_COORDINATE: f64 = 1e100;
+
+/// The largest load component a model may have (N, N·m): norms of the load vector and the
+/// displacements it causes stay finite.
+pub const MAX_LOAD: f64 = 1e100;
+
 fn check_cell(c: &super::CellSpec) -> Result<(), ModelError> {
     let bad = |what: &str, v: f64| {
         ModelError::InvalidCell(format!("{what} = {v} must be finite and > 0"))
@@ -211,7 +219,7 @@ impl Model {
             if node_index.insert(n.id, nodes.len()).is_some() {
                 return Err(ModelError::DuplicateNode(n.id));
             }
-            if n.x.iter().any(|c| !c.is_finite()) {
+            if n.x.iter().any(|c| !(c.abs() <= MAX_COORDINATE)) {
                 return Err(ModelError::NonFiniteCoordinate {
                     node: n.id,
                     coordinate: n.x,
@@ -289,10 +297,18 @@ impl Model {
                 used[a] = true;
                 used[b] = true;
             }
+            let section = Section { radius: f.radius };
+            let young = materials[material].young;
+            if !(young * section.second_moment()).is_finite() {
+                return Err(ModelError::InvalidRadius {
+                    fiber: f.id,
+                    radius: f.radius,
+                });
+            }
             fibers.push(Fiber {
                 id: f.id,
                 nodes: idx,
-                section: Section { radius: f.radius },
+                section,
                 material,
             });
         }
@@ -303,7 +319,7 @@ impl Model {
         let mut prescribed: HashMap<(usize, Dof), f64> = HashMap::new();
         for s in &d.supports {
             let node = lookup(s.node, &|| "a support".to_string())?;
-            if !s.value.is_finite() {
+            if !(s.value.abs() <= MAX_COORDINATE) {
                 return Err(ModelError::NonFiniteValue {
                     node: s.node,
                     what: "prescribed value",
@@ -328,7 +344,11 @@ impl Model {
         let mut loads = Vec::new();
         for l in &d.loads {
             let node = lookup(l.node, &|| "a load".to_string())?;
-            if l.force.iter().chain(&l.moment).any(|v| !v.is_finite()) {
+            if l.force
+                .iter()
+                .chain(&l.moment)
+                .any(|v| !(v.abs() <= MAX_LOAD))
+            {
                 return Err(ModelError::NonFiniteValue {
                     node: l.node,
                     what: "load",

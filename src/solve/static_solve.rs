@@ -138,6 +138,16 @@ pub(crate) fn check_backward_error(
     }))
 }
 
+/// The error of a solution that overflowed, with the model's largest load or prescribed value.
+pub(crate) fn non_finite_solution(model: &Model, context: &str) -> Error {
+    let loads = model.loads.iter().map(|l| l.value.abs());
+    let prescribed = model.supports.iter().map(|s| s.value.abs());
+    Error::NonFiniteSolution {
+        context: context.to_string(),
+        largest: loads.chain(prescribed).fold(0.0, f64::max),
+    }
+}
+
 /// Solves K u = F for the supports and loads of `model`.
 pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolution, Error> {
     check_supported(model)?;
@@ -210,6 +220,9 @@ pub fn solve_static(model: &Model, options: &SolveOptions) -> Result<StaticSolut
         x
     };
     let u = sys.dofs.generalized(&reduced, 1.0);
+    if u.iter().any(|v| !v.is_finite()) {
+        return Err(non_finite_solution(model, "static solve"));
+    }
     summary.timings = timings;
     Ok(StaticSolution {
         displacements: u

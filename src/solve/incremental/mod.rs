@@ -61,7 +61,7 @@ use setup::Setup;
 
 use super::kept_contact_loads::KeptContactLoads;
 use super::low_rank::Capacitance;
-use super::static_solve::check_backward_error;
+use super::static_solve::{check_backward_error, non_finite_solution};
 use crate::constraints::Discretization;
 use crate::contact::{ContactSet, ContactSide};
 use crate::model::Model;
@@ -310,6 +310,9 @@ impl<'a, 'h> StickSlip<'a, 'h> {
         let bwd = solved.report.as_ref().map_or(0.0, |r| r.backward_error);
         check_backward_error(&self.setup.opts.solve, bwd, &inc.name())?;
         inc.lap(|t| &mut t.solve);
+        if solved.x.iter().any(|v| !v.is_finite()) {
+            return Err(non_finite_solution(self.setup.model, &inc.name()));
+        }
         self.q = self.setup.disc.generalized(&solved.x, inc.alpha);
         Ok(solved)
     }
