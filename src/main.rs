@@ -547,10 +547,8 @@ fn solve(
     (out, vtk): (&Path, io::VtkEncoding),
 ) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
-    std::fs::create_dir_all(out).map_err(|e| Error::Output {
-        path: out.display().to_string(),
-        message: e.to_string(),
-    })?;
+    // displacements.json is written last: a folder that holds it is complete.
+    io::begin_results(out, "displacements.json")?;
     if model.has_contact() {
         return solve_with_contact(model_path, &model, options, incremental, json, (out, vtk));
     }
@@ -560,11 +558,11 @@ fn solve(
         &out.join("displacements.csv"),
         &io::displacements_csv(&model, &sol.displacements),
     )?;
-    write(&out.join("displacements.json"), &pretty)?;
     write(
         &out.join("network.vtp"),
         &io::network_vtk(&model, &sol.displacements, NetworkFormat::PolyData, vtk),
     )?;
+    write(&out.join("displacements.json"), &pretty)?;
     if json {
         println!("{pretty}");
         return Ok(());
@@ -634,7 +632,6 @@ fn solve_with_contact(
         &out.join("displacements.csv"),
         &io::displacements_csv(model, final_u),
     )?;
-    write(&out.join("displacements.json"), &pretty)?;
     write(&out.join("increments.csv"), &io::increments_csv(&sol))?;
     write(&out.join("contacts.csv"), &io::contacts_csv(&sol))?;
     for (k, rec) in sol.increments.iter().enumerate() {
@@ -648,6 +645,7 @@ fn solve_with_contact(
         )?;
     }
     write(&out.join("solution.pvd"), &io::series_pvd(&sol))?;
+    write(&out.join("displacements.json"), &pretty)?;
     if json {
         println!("{pretty}");
         return Ok(());
@@ -699,11 +697,8 @@ fn homogenize(
     let h = fibercell::homogenize::homogenize_elastic(&model, &options)?;
     let pretty = to_pretty(&h)?;
     if let Some(out) = out {
-        std::fs::create_dir_all(out).map_err(|e| Error::Output {
-            path: out.display().to_string(),
-            message: e.to_string(),
-        })?;
-        write(&out.join("homogenized.json"), &pretty)?;
+        // homogenized.json is written last: a folder that holds it is complete.
+        io::begin_results(out, "homogenized.json")?;
         for (k, case) in h.cases.iter().enumerate() {
             let name = format!("case_{}.vtp", fibercell::cell::MACRO_NAMES[k]);
             write(
@@ -720,6 +715,7 @@ fn homogenize(
                 vtk,
             ),
         )?;
+        write(&out.join("homogenized.json"), &pretty)?;
     }
     if json {
         println!("{pretty}");
@@ -784,6 +780,8 @@ fn curve(
 ) -> Result<(), Error> {
     use fibercell::homogenize::{elasto_plastic_curve, CurveOptions};
     let model = io::load_model(model_path)?;
+    // curve.json is written last: a folder that holds it is complete.
+    io::begin_results(out, "curve.json")?;
     let (bar, progress) = progress_bar("curve");
     let incremental = IncrementalOptions {
         progress: Some(progress),
@@ -1205,6 +1203,13 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // Interrupted (Ctrl-C, SIGTERM, SIGHUP), remove the temporary files of outputs under way;
+    // every output is renamed into place whole, so none is left half written.
+    let _ = ctrlc::set_handler(|| {
+        let removed = io::remove_unfinished_outputs();
+        eprintln!("interrupted; {removed} unfinished output file(s) removed");
+        std::process::exit(130);
+    });
     let cli = Cli::parse();
     let r = match cli.command {
         Command::Solve {

@@ -801,3 +801,54 @@ fn angles_are_degrees_and_outputs_say_dir_or_file() {
     let help = run(&["curve", "--help"]);
     assert!(String::from_utf8_lossy(&help.stdout).contains("-d, --out-dir <DIR>"));
 }
+
+/// A run killed midway leaves no `.fibercell-*.tmp` files, and no JSON document of an earlier
+/// run that would make its folder look complete (the JSON is written last).
+#[test]
+#[cfg(unix)]
+fn an_interrupted_run_leaves_no_temporary_files_nor_an_old_json() {
+    let out = tmpdir("interrupted");
+    std::fs::create_dir_all(&out).unwrap();
+    let stale = out.join("curve.json");
+    std::fs::write(&stale, "{\"from\": \"an earlier run\"}").unwrap();
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_fibercell"))
+        .args([
+            "curve",
+            "fixtures/cells/nonwoven_small.toml",
+            "--strain",
+            "e11=0.01",
+            "--steps",
+            "20000",
+            "-d",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The old JSON goes as soon as the results folder is prepared, before the curve runs.
+    let started = std::time::Instant::now();
+    while stale.exists() && started.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(
+        !stale.exists(),
+        "the earlier run's curve.json is still there"
+    );
+    // SAFETY: kill(2) with the child's pid and SIGTERM.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("interrupted"));
+    let left: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(left.iter().all(|n| !n.ends_with(".tmp")), "{left:?}");
+    assert!(!left.iter().any(|n| n == "curve.json"), "{left:?}");
+}

@@ -130,13 +130,11 @@ pub fn curve_plot(c: &Curve, title: &str) -> Result<(String, Vec<u8>), Error> {
     Ok((plot.svg()?, plot.png()?))
 }
 
-/// Writes `curve.csv`, `switches.csv`, `curve.json`, `curve.svg` and `curve.png` into `dir`
-/// (created if missing), each atomically; returns their paths.
+/// Writes `curve.csv`, `switches.csv`, `curve.svg`, `curve.png` and last `curve.json` into
+/// `dir` (created if missing), each atomically, so that a folder with `curve.json` is complete
+/// (see [`super::begin_results`]); returns their paths.
 pub fn write_curve_files(dir: &Path, c: &Curve, title: &str) -> Result<Vec<PathBuf>, Error> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Output {
-        path: dir.display().to_string(),
-        message: e.to_string(),
-    })?;
+    super::begin_results(dir, "curve.json")?;
     let json = serde_json::to_string_pretty(c).map_err(|e| Error::Output {
         path: "curve.json".into(),
         message: e.to_string(),
@@ -146,9 +144,9 @@ pub fn write_curve_files(dir: &Path, c: &Curve, title: &str) -> Result<Vec<PathB
     let files: [(&str, &[u8]); 5] = [
         ("curve.csv", curve.as_bytes()),
         ("switches.csv", switches.as_bytes()),
-        ("curve.json", json.as_bytes()),
         ("curve.svg", svg.as_bytes()),
         ("curve.png", &png),
+        ("curve.json", json.as_bytes()),
     ];
     let mut written = Vec::new();
     for (name, bytes) in files {

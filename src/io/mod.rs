@@ -15,7 +15,7 @@ mod vtk;
 
 pub use abaqus::{parse_abaqus, MAX_GENERATED_MEMBERS};
 pub use abaqus_export::to_abaqus;
-pub use atomic::write_atomic;
+pub use atomic::{begin_results, remove_unfinished_outputs, write_atomic};
 pub use curve_files::{
     curve_csv, curve_plot, dominant_component, switches_csv, write_curve_files, RESULTANT_NAMES,
     RESULTANT_UNITS, STRAIN_UNITS,
