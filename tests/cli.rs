@@ -852,3 +852,47 @@ fn an_interrupted_run_leaves_no_temporary_files_nor_an_old_json() {
     assert!(left.iter().all(|n| !n.ends_with(".tmp")), "{left:?}");
     assert!(!left.iter().any(|n| n == "curve.json"), "{left:?}");
 }
+
+/// A target that cannot be written (here: a directory of that name) is named in the error,
+/// never the temporary file the output was written to first.
+#[test]
+fn write_errors_name_the_target_not_a_temporary_file() {
+    let out = tmpdir("unwritable");
+    let matrix = out.join("K.mtx");
+    std::fs::create_dir_all(&matrix).unwrap();
+    let marker = out.join("curve.json");
+    std::fs::create_dir_all(&marker).unwrap();
+    for (args, target) in [
+        (
+            vec![
+                "export-matrix",
+                "fixtures/ok_frame3d.toml",
+                "-o",
+                matrix.to_str().unwrap(),
+            ],
+            matrix.display().to_string(),
+        ),
+        (
+            vec![
+                "curve",
+                "fixtures/cells/woven_small.toml",
+                "--strain",
+                "e11=0.001",
+                "--steps",
+                "2",
+                "-d",
+                out.to_str().unwrap(),
+            ],
+            marker.display().to_string(),
+        ),
+    ] {
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(err.contains(&format!("cannot write {target}")), "{err}");
+        assert!(
+            !err.contains(".tmp") && !err.contains(".fibercell-"),
+            "{err}"
+        );
+    }
+}

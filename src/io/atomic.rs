@@ -58,13 +58,14 @@ fn in_flight<R>(f: impl FnOnce(&mut Vec<PathBuf>) -> R) -> R {
 /// so that a folder holding it is complete: creates the folder and removes a `marker` left by
 /// an earlier run (a run interrupted now must not leave an old one looking complete).
 pub fn begin_results(dir: &Path, marker: &str) -> Result<(), Error> {
-    let err = |e: std::io::Error| Error::Output {
-        path: dir.display().to_string(),
+    let err = |path: &Path, e: std::io::Error| Error::Output {
+        path: path.display().to_string(),
         message: e.to_string(),
     };
-    std::fs::create_dir_all(dir).map_err(err)?;
-    match std::fs::remove_file(dir.join(marker)) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(err(e)),
+    std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
+    let marker = dir.join(marker);
+    match std::fs::remove_file(&marker) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(err(&marker, e)),
         _ => Ok(()),
     }
 }
