@@ -10,7 +10,6 @@ use super::{element_stiffness, Assembler, FillMode, Pattern, NO_SLOT};
 use crate::constraints::Discretization;
 use crate::model::Model;
 use crate::Error;
-use fibercell_solver::SolverError;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -147,14 +146,7 @@ impl ElementBlocks {
             Assembler::new(model).fill(model, pattern, values, mode)?;
             return Ok(());
         }
-        if values.len() != pattern.nnz() {
-            return Err(SolverError::DimensionMismatch(format!(
-                "{} values for a pattern of {} entries",
-                values.len(),
-                pattern.nnz()
-            ))
-            .into());
-        }
+        pattern.check_values(values)?;
         values.iter_mut().for_each(|v| *v = 0.0);
         self.for_each_matrix(model, |e, k| {
             let m = k.nrows();

@@ -75,13 +75,7 @@ impl Assembler {
         values: &mut [f64],
         mode: FillMode,
     ) -> Result<(), SolverError> {
-        if values.len() != pattern.nnz() {
-            return Err(SolverError::DimensionMismatch(format!(
-                "{} values for a pattern of {} entries",
-                values.len(),
-                pattern.nnz()
-            )));
-        }
+        pattern.check_values(values)?;
         values.iter_mut().for_each(|v| *v = 0.0);
         match mode {
             FillMode::Serial => {

@@ -122,6 +122,18 @@ impl Pattern {
     pub fn n(&self) -> usize {
         self.n
     }
+    /// `values` must hold one value per slot of this pattern.
+    pub fn check_values(&self, values: &[f64]) -> Result<(), fibercell_solver::SolverError> {
+        if values.len() == self.nnz() {
+            return Ok(());
+        }
+        Err(fibercell_solver::SolverError::DimensionMismatch(format!(
+            "{} values for a pattern of {} entries",
+            values.len(),
+            self.nnz()
+        )))
+    }
+
     /// Stored entries (both triangles).
     pub fn nnz(&self) -> usize {
         self.row_idx.len()
