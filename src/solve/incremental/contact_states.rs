@@ -2,6 +2,7 @@
 //! history, the linearization across the slip direction, the Coulomb bounds of the fixed
 //! point, and the switches that detect chatter.
 
+use super::bound_acceleration::BoundAcceleration;
 use super::options::{BOUND_RELAXATION_AFTER, CHATTER_SWITCHES, SETTLING_ITERATIONS};
 use super::return_mapping::Trial;
 use super::setup::Setup;
@@ -22,6 +23,8 @@ pub(super) struct ContactStates {
     pub bounds: Vec<f64>,
     /// State switches per contact in this increment (chatter detection).
     pub switches: Vec<usize>,
+    /// The fixed point's history in this increment.
+    pub acceleration: BoundAcceleration,
     friction: Friction,
     bound_fixed_point: bool,
 }
@@ -45,6 +48,7 @@ impl ContactStates {
                 _ => Vec::new(),
             },
             switches: vec![0; n],
+            acceleration: BoundAcceleration::default(),
             friction,
             bound_fixed_point: setup.bound_fixed_point,
         }
@@ -117,18 +121,26 @@ impl ContactStates {
             self.directions[i] = trials[i].direction;
         }
         if self.bound_fixed_point {
-            // The fixed point converges linearly with μ times the coupling of a contact's
-            // normal force to its own friction force; where that coupling is strong the
-            // plain update oscillates, so later iterations take half the step.
-            let step = if iteration > BOUND_RELAXATION_AFTER {
+            let sliding: Vec<usize> = (0..trials.len())
+                .filter(|&i| trials[i].state == ContactState::Slip)
+                .collect();
+            let trial: Vec<f64> = trials.iter().map(|t| t.bound).collect();
+            let floor = match self.friction {
+                Friction::Coulomb { cohesion, .. } => cohesion,
+                _ => 0.0,
+            };
+            // Where the coupling is strong the plain update oscillates: later iterations
+            // take half the step.
+            let relaxation = if iteration > BOUND_RELAXATION_AFTER {
                 0.5
             } else {
                 1.0
             };
-            for (b, t) in self.bounds.iter_mut().zip(trials) {
-                if t.state == ContactState::Slip {
-                    *b += step * (t.bound - *b);
-                }
+            let next = self
+                .acceleration
+                .next(&sliding, &self.bounds, &trial, floor, relaxation);
+            for (&i, b) in sliding.iter().zip(next) {
+                self.bounds[i] = b;
             }
         }
         for (i, t) in trials.iter().enumerate() {

@@ -25,6 +25,7 @@
 //! convergence commit ([`commit`]).
 
 mod assemble;
+mod bound_acceleration;
 mod classify;
 mod commit;
 mod contact_states;
@@ -210,6 +211,7 @@ impl<'a, 'h> StickSlip<'a, 'h> {
         // New α and committed slips: a new reference load.
         self.factors.reference_solution = None;
         self.contacts.switches.fill(0);
+        self.contacts.acceleration.restart();
         let max_iterations = self.setup.opts.max_state_iterations;
         for iteration in 1..=max_iterations {
             let mut system = self.assemble(&mut inc)?;
