@@ -171,6 +171,13 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         vtk: VtkArgs,
+        /// The solver a .inp file is for: abaqus (two-node B31 beams, read back exactly) or
+        /// calculix (ccx: B32 beams with midside nodes, and a cell step applying --cell-strain).
+        #[arg(long, value_name = "SOLVER", default_value = "abaqus", value_parser = flavour_parser())]
+        flavour: io::InpFlavour,
+        /// Membrane strain of a cell's CalculiX step, e.g. e11=0.001 or g12=0.002.
+        #[arg(long, value_parser = parse_strain, default_value = "e11=0.001")]
+        cell_strain: fibercell::cell::MacroStrain,
     },
     /// Throughput benchmark on generated non-woven cells: every stage timed, against the
     /// machine's measured DGEMM and memory bandwidth (see the README's performance section).
@@ -441,6 +448,17 @@ fn solver_parser() -> impl clap::builder::TypedValueParser<Value = SolverKind> {
 }
 
 /// `--vtk`: the encodings' names, listed in `--help`.
+fn flavour_parser() -> impl clap::builder::TypedValueParser<Value = io::InpFlavour> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(["abaqus", "calculix"]).map(|s| {
+        if s == "calculix" {
+            io::InpFlavour::CalculiX
+        } else {
+            io::InpFlavour::Abaqus
+        }
+    })
+}
+
 fn vtk_parser() -> impl clap::builder::TypedValueParser<Value = io::VtkEncoding> {
     use clap::builder::TypedValueParser;
     clap::builder::PossibleValuesParser::new(["auto", "ascii", "binary"]).map(|s| {
@@ -1052,9 +1070,9 @@ fn stats(model_path: &Path, json: bool, rose: Option<&Path>) -> Result<(), Error
     Ok(())
 }
 
-fn convert(input: &Path, output: &Path, vtk: io::VtkEncoding) -> Result<(), Error> {
+fn convert(input: &Path, output: &Path, opts: &io::WriteOptions) -> Result<(), Error> {
     let d = io::read_description(input)?;
-    let written = io::write_model(output, &d, vtk)?;
+    let written = io::write_model(output, &d, opts)?;
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     println!("{} → {}", input.display(), names.join(", "));
     Ok(())
@@ -1258,7 +1276,22 @@ fn main() -> ExitCode {
         ),
         Command::Generate { kind } => generate(kind),
         Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),
-        Command::Convert { input, output, vtk } => convert(&input, &output, vtk.encoding),
+        Command::Convert {
+            input,
+            output,
+            vtk,
+            flavour,
+            cell_strain,
+        } => {
+            let opts = io::WriteOptions {
+                vtk: vtk.encoding,
+                inp: io::InpOptions {
+                    flavour,
+                    cell_strain,
+                },
+            };
+            convert(&input, &output, &opts)
+        }
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
         Command::SolveMatrix {
             matrix,

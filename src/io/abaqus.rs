@@ -47,8 +47,38 @@ struct Reader {
     contact: Option<crate::model::ContactSpec>,
     contacts: Vec<crate::model::ContactPairSpec>,
     cell: Option<crate::model::CellSpec>,
+    /// Exact coordinates of nodes whose `*NODE` line is rounded to the 20-character field.
+    exact_nodes: Vec<ExactNode>,
     /// Members of all `GENERATE` sets so far (see [`MAX_GENERATED_MEMBERS`]).
     generated: usize,
+}
+
+/// A `** fibercell-node:` comment: the exact coordinates of a node the exporter rounded.
+#[derive(serde::Deserialize)]
+struct ExactNode {
+    id: u64,
+    x: [f64; 3],
+}
+
+impl Reader {
+    /// The exact coordinates of the nodes whose lines still hold what the exporter wrote for
+    /// them (a line edited since keeps its own values).
+    fn restore_exact_nodes(&mut self) {
+        let exact: HashMap<u64, [f64; 3]> = self.exact_nodes.iter().map(|n| (n.id, n.x)).collect();
+        for node in &mut self.nodes {
+            let Some(x) = exact.get(&node.id) else {
+                continue;
+            };
+            let written = x.map(|v| super::inp_number(v).parse::<f64>());
+            if written
+                .iter()
+                .zip(&node.x)
+                .all(|(w, v)| w.as_ref() == Ok(v))
+            {
+                node.x = *x;
+            }
+        }
+    }
 }
 
 /// The most members all `GENERATE` sets of one file may hold together (80 MB of ids): 700
@@ -61,8 +91,12 @@ enum Block {
     Heading,
     Node,
     Element,
-    Nset { generate: bool },
-    Elset { generate: bool },
+    Nset {
+        generate: bool,
+    },
+    Elset {
+        generate: bool,
+    },
     BeamSection,
     BeamSectionDirection,
     Elastic,
@@ -70,6 +104,8 @@ enum Block {
     Boundary,
     Cload,
     Equation,
+    /// The variables of an output request (ignored).
+    Output,
 }
 
 fn params(parts: &[&str]) -> HashMap<String, String> {
@@ -300,7 +336,7 @@ impl Reader {
                 });
                 return Ok(Block::None);
             }
-            Block::Static => {}
+            Block::Static | Block::Output => {}
             Block::Boundary => {
                 need(2, "*BOUNDARY")?;
                 let targets = self.node_targets(line, fields[0])?;
@@ -421,7 +457,7 @@ impl Reader {
 
     /// A `** fibercell-…:` comment: settings with no Abaqus keyword, as JSON.
     fn fibercell_comment(&mut self, line: usize, t: &str) -> Result<(), InputError> {
-        use super::abaqus_export::{CELL_COMMENT, CONTACT_COMMENT, PAIR_COMMENT};
+        use super::abaqus_export::{CELL_COMMENT, CONTACT_COMMENT, NODE_COMMENT, PAIR_COMMENT};
         if let Some(body) = t.strip_prefix(CONTACT_COMMENT) {
             self.contact = Some(self.json_setting(line, body)?);
         } else if let Some(body) = t.strip_prefix(PAIR_COMMENT) {
@@ -429,6 +465,9 @@ impl Reader {
             self.contacts.push(pair);
         } else if let Some(body) = t.strip_prefix(CELL_COMMENT) {
             self.cell = Some(self.json_setting(line, body)?);
+        } else if let Some(body) = t.strip_prefix(NODE_COMMENT) {
+            let exact: ExactNode = self.json_setting(line, body)?;
+            self.exact_nodes.push(exact);
         }
         Ok(())
     }
@@ -539,6 +578,10 @@ impl Reader {
             }
             "STATIC" => Block::Static,
             "END STEP" => Block::None,
+            // Output requests change nothing in the model.
+            "NODE PRINT" | "NODE FILE" | "EL PRINT" | "EL FILE" | "NODE OUTPUT"
+            | "ELEMENT OUTPUT" => Block::Output,
+            "OUTPUT" => Block::None,
             "BOUNDARY" => {
                 if p.contains_key("TYPE") || p.contains_key("OP") {
                     return Err(self.err(line, "*BOUNDARY options TYPE= and OP= are not supported"));
@@ -667,6 +710,7 @@ pub fn parse_abaqus(text: &str, path: &str) -> Result<ModelDescription, InputErr
             block = r.data_line(block, line, &fields, &mut ctx)?;
         }
     }
+    r.restore_exact_nodes();
     let path_err = |line: usize, m: String| InputError::Syntax {
         path: path.into(),
         line,

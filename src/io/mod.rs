@@ -7,6 +7,7 @@ mod abaqus_export;
 mod atomic;
 mod curve_files;
 mod error;
+mod inp_number;
 mod matrix_market;
 mod native;
 mod plot;
@@ -14,13 +15,14 @@ mod results;
 mod vtk;
 
 pub use abaqus::{parse_abaqus, MAX_GENERATED_MEMBERS};
-pub use abaqus_export::to_abaqus;
+pub use abaqus_export::{to_abaqus, to_inp, InpFlavour, InpOptions};
 pub use atomic::{begin_results, remove_unfinished_outputs, write_atomic};
 pub use curve_files::{
     curve_csv, curve_plot, dominant_component, switches_csv, write_curve_files, RESULTANT_NAMES,
     RESULTANT_UNITS, STRAIN_UNITS,
 };
 pub use error::InputError;
+pub use inp_number::{inp_number, MAX_FIELD};
 pub use matrix_market::{write_matrix_market, write_matrix_market_dense};
 pub use native::{parse_json, parse_toml, parse_toml_as, to_json, to_toml};
 pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};
@@ -94,16 +96,25 @@ pub fn write_description(path: &Path, d: &ModelDescription) -> Result<(), Error>
     write_atomic(path, text.as_bytes())
 }
 
-/// Writes a model in the format of the path's extension — `.toml`, `.json`, `.inp` (Abaqus),
+/// How [`write_model`] writes: the VTK encoding and the input-file flavour.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WriteOptions {
+    pub vtk: VtkEncoding,
+    pub inp: InpOptions,
+}
+
+/// Writes a model in the format of the path's extension — `.toml`, `.json`, `.inp` (Abaqus,
+/// or CalculiX by `opts.inp`),
 /// `.vtp` or `.vtu` (the network with its radius, see [`network_vtk`]) or `.pvd` (a
 /// collection of `{stem}_fibers.vtp` and `{stem}_contacts.vtp` written next to it) —
-/// validating it first; each file is written atomically, VTK files in `encoding`. Returns the
+/// validating it first; each file is written atomically, VTK files in `opts.vtk`. Returns the
 /// paths written.
 pub fn write_model(
     path: &Path,
     d: &ModelDescription,
-    encoding: VtkEncoding,
+    opts: &WriteOptions,
 ) -> Result<Vec<std::path::PathBuf>, Error> {
+    let encoding = opts.vtk;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -111,7 +122,7 @@ pub fn write_model(
     let model = Model::from_description(d)?;
     match ext.as_deref() {
         Some("toml") | Some("json") => write_description(path, d)?,
-        Some("inp") => write_atomic(path, to_abaqus(d)?.as_bytes())?,
+        Some("inp") => write_atomic(path, to_inp(d, &opts.inp)?.as_bytes())?,
         Some(ext @ ("vtp" | "vtu")) => {
             let format = if ext == "vtp" {
                 NetworkFormat::PolyData
