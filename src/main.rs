@@ -1150,67 +1150,10 @@ fn solve_matrix(
     Ok(())
 }
 
-/// The system a model's job solves: a cell's six cell problems, or a supported model's
-/// reduced K u = F.
-fn job_system(
-    model: &fibercell::Model,
-) -> Result<(fibercell::homogenize::LinearSystem, &'static str), Error> {
-    if model.cell.is_some() {
-        return Ok((
-            fibercell::homogenize::cell_problem(model)?,
-            "the six elastic cell problems K_ff x_k = -K_fE e_k (e_k = e11 e22 g12 k11 k22 k12; periodic nodes eliminated, one node anchored, closed contacts in stick)",
-        ));
-    }
-    let sys = fibercell::solve::ReducedSystem::assemble(model, Default::default())?;
-    let dofs = (0..sys.dofs.n_free())
-        .map(|k| {
-            let (node, dof) = sys.dofs.node_dof(k);
-            (model.nodes[node].id, dof)
-        })
-        .collect();
-    Ok((
-        fibercell::homogenize::LinearSystem {
-            matrix: sys.matrix()?.to_owned(),
-            rhs: sys.rhs.clone(),
-            columns: 1,
-            dofs,
-        },
-        "the reduced static problem K u = F (supported DOFs removed)",
-    ))
-}
-
 fn export_matrix(model_path: &Path, out: &Path) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
-    let (system, what) = job_system(&model)?;
-    let n = system.dofs.len();
-    let stem = out.with_extension("");
-    let sibling = |suffix: &str| PathBuf::from(format!("{}{suffix}", stem.display()));
-    let (rhs_path, dofs_path) = (sibling("_rhs.mtx"), sibling("_dofs.csv"));
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| Error::Output {
-            path: dir.display().to_string(),
-            message: e.to_string(),
-        })?;
-    }
-    let comment = format!(
-        "{} of {} ({n} unknowns, SI units); row k is the unknown in row k of {}",
-        what,
-        model_path.display(),
-        dofs_path.display()
-    );
-    let mut map = String::from("row,node,dof\n");
-    for (k, (node, dof)) in system.dofs.iter().enumerate() {
-        map.push_str(&format!("{},{node},{}\n", k + 1, dof.name()));
-    }
-    io::write_atomic(
-        &rhs_path,
-        io::write_matrix_market_dense(n, system.columns, &system.rhs, &comment).as_bytes(),
-    )?;
-    io::write_atomic(&dofs_path, map.as_bytes())?;
-    io::write_atomic(
-        out,
-        io::write_matrix_market(system.matrix.as_ref(), &comment).as_bytes(),
-    )
+    let job = fibercell::solve::job_system(&model)?;
+    io::write_job_system(&job, model_path, out).map(|_| ())
 }
 
 fn main() -> ExitCode {

@@ -1,7 +1,10 @@
 //! Matrix Market `coordinate real symmetric` output (lower triangle, 1-based).
 
+use super::write_atomic;
+use crate::Error;
 use fibercell_solver::CscRef;
 use std::fmt::Write;
+use std::path::{Path, PathBuf};
 
 /// `columns` dense columns of length `n` (stored column after column) in Matrix Market
 /// `array real general` form.
@@ -43,4 +46,44 @@ pub fn write_matrix_market(a: CscRef<'_>, comment: &str) -> String {
         }
     }
     s
+}
+
+/// Writes `job` ([`crate::solve::job_system`] of the model at `source`) to `out` (Matrix
+/// Market, symmetric, lower triangle), its right-hand sides to `OUT_rhs.mtx` and the node and
+/// DOF of every row to `OUT_dofs.csv`, each file atomically; the header of both matrices says
+/// which problem it is and where the rows are described. Returns the three paths.
+pub fn write_job_system(
+    job: &crate::solve::JobSystem,
+    source: &Path,
+    out: &Path,
+) -> Result<[PathBuf; 3], Error> {
+    let system = &job.system;
+    let n = system.dofs.len();
+    let stem = out.with_extension("");
+    let sibling = |suffix: &str| PathBuf::from(format!("{}{suffix}", stem.display()));
+    let (rhs_path, dofs_path) = (sibling("_rhs.mtx"), sibling("_dofs.csv"));
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Error::Output {
+            path: dir.display().to_string(),
+            message: e.to_string(),
+        })?;
+    }
+    let comment = format!(
+        "{} of {} ({n} unknowns, SI units); row k is the unknown in row k of {}",
+        job.description,
+        source.display(),
+        dofs_path.display()
+    );
+    let mut map = String::from("row,node,dof\n");
+    for (k, (node, dof)) in system.dofs.iter().enumerate() {
+        map.push_str(&format!("{},{node},{}\n", k + 1, dof.name()));
+    }
+    let rhs = write_matrix_market_dense(n, system.columns, &system.rhs, &comment);
+    write_atomic(&rhs_path, rhs.as_bytes())?;
+    write_atomic(&dofs_path, map.as_bytes())?;
+    write_atomic(
+        out,
+        write_matrix_market(system.matrix.as_ref(), &comment).as_bytes(),
+    )?;
+    Ok([out.to_path_buf(), rhs_path, dofs_path])
 }

@@ -23,7 +23,7 @@ pub use curve_files::{
 };
 pub use error::InputError;
 pub use inp_number::{inp_number, MAX_FIELD};
-pub use matrix_market::{write_matrix_market, write_matrix_market_dense};
+pub use matrix_market::{write_job_system, write_matrix_market, write_matrix_market_dense};
 pub use native::{parse_json, parse_toml, parse_toml_as, to_json, to_toml};
 pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};
 pub use results::{

@@ -6,6 +6,7 @@ mod connectivity;
 mod gram;
 mod increment_timings;
 mod incremental;
+mod job_system;
 mod kept_contact_loads;
 mod low_rank;
 mod matrix_solve;
@@ -21,6 +22,7 @@ pub use incremental::{
     IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, BOUND_TOLERANCE,
     MAX_CONTACT_RECORDS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
 };
+pub use job_system::{job_system, JobSystem};
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
 pub use matrix_solve::{solve_matrix, MatrixSolveReport};
 pub use reduced::ReducedSystem;
