@@ -473,15 +473,7 @@ fn vtk_parser() -> impl clap::builder::TypedValueParser<Value = io::VtkEncoding>
 /// `--ordering`: the orderings' names, listed in `--help`.
 fn ordering_parser() -> impl clap::builder::TypedValueParser<Value = Ordering> {
     use clap::builder::TypedValueParser;
-    clap::builder::PossibleValuesParser::new(["auto", "amd", "nd", "natural"]).try_map(|s| match s
-        .as_str()
-    {
-        "auto" => Ok(Ordering::Auto),
-        "amd" => Ok(Ordering::Amd),
-        "nd" => Ok(Ordering::NestedDissection),
-        "natural" => Ok(Ordering::Natural),
-        _ => Err(format!("unknown ordering \"{s}\"")),
-    })
+    clap::builder::PossibleValuesParser::new(Ordering::NAMES).try_map(|s| Ordering::parse(&s))
 }
 
 fn parse_strain(s: &str) -> Result<fibercell::cell::MacroStrain, String> {

@@ -36,6 +36,22 @@ impl Ordering {
             Ordering::Given(_) => "given",
         }
     }
+
+    /// The names [`Ordering::parse`] takes, as the CLI's `--ordering` lists them.
+    pub const NAMES: [&'static str; 4] = ["auto", "amd", "nd", "natural"];
+
+    /// The ordering called `name` (one of [`Ordering::NAMES`]; `nested-dissection` too).
+    pub fn parse(name: &str) -> Result<Ordering, String> {
+        match name {
+            "auto" => Ok(Ordering::Auto),
+            "amd" => Ok(Ordering::Amd),
+            "nd" | "nested-dissection" => Ok(Ordering::NestedDissection),
+            "natural" => Ok(Ordering::Natural),
+            _ => Err(format!(
+                "unknown ordering \"{name}\" (use auto, amd, nd or natural)"
+            )),
+        }
+    }
 }
 
 /// A permutation with its inverse: `fwd[new] = old`, `inv[old] = new`.
