@@ -1,0 +1,170 @@
+"""fibercell: effective mechanical properties of textiles from fiber-network cells.
+
+A thin layer over the Rust library (``fibercell._fibercell``): models from files, strings or
+dictionaries, the cell generators, the elastic homogenization (ABD), the friction-driven
+elasto-plastic curve and the sparse solver layer. Results are the documents the CLI prints
+with ``--json`` (the same serializer, the same digits), with NumPy arrays for the matrices and
+the curve's columns. Errors raise :class:`FibercellError` (a ``ValueError``) with the
+library's message; every computation releases the GIL.
+
+>>> import fibercell
+>>> cell = fibercell.Model.load("fixtures/ok_cell_grid.toml")
+>>> h = fibercell.homogenize(cell)
+>>> round(h["abd"][0, 0])  # A11 = EA / Ly in N/m
+17952
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Mapping, Optional, Tuple, Union
+
+import numpy as np
+
+from ._fibercell import FibercellError, Model, __version__
+from . import _fibercell
+
+__all__ = [
+    "FibercellError",
+    "Model",
+    "SparseSolver",
+    "__version__",
+    "curve",
+    "generate",
+    "homogenize",
+    "model_from_dict",
+    "solve",
+]
+
+STRAIN_NAMES = ("e11", "e22", "g12", "k11", "k22", "k12")
+
+
+def model_from_dict(description: Mapping[str, Any]) -> Model:
+    """A model from a dictionary with the fields of a JSON model file."""
+    return Model.from_json(json.dumps(description))
+
+
+def generate(family: str, **params: Any) -> Model:
+    """A generated periodic cell: ``family`` is "woven", "geotextile", "knitted" or
+    "nonwoven"; ``params`` are the generator's fields as in ``fixtures/cells/*.params.toml``
+    (those not given keep their defaults)."""
+    return _fibercell.generate_json(json.dumps({"family": family, **params}))
+
+
+def homogenize(model: Model, solver: str = "faer-cholesky", ordering: str = "auto") -> dict:
+    """The elastic ABD of a periodic cell (thesis 5.5), its moduli and orthotropic constants:
+    the document of ``fibercell homogenize --json``, with ``abd`` as a 6 × 6 array (rows and
+    columns e11 e22 g12 k11 k22 k12; A in N/m, B in N, D in N·m)."""
+    doc = json.loads(_fibercell.homogenize_json(model, solver=solver, ordering=ordering))
+    doc["abd"] = np.array(doc["abd"], dtype=float)
+    return doc
+
+
+def _strain_text(strain: Union[str, Mapping[str, float]]) -> str:
+    if isinstance(strain, str):
+        return strain
+    unknown = [k for k in strain if k not in STRAIN_NAMES]
+    if unknown:
+        raise FibercellError(
+            f"unknown strain component(s) {unknown}: use {', '.join(STRAIN_NAMES)}"
+        )
+    return ",".join(f"{k}={float(v)!r}" for k, v in strain.items())
+
+
+def curve(
+    model: Model,
+    strain: Union[str, Mapping[str, float]],
+    steps: int = 100,
+    unload: bool = False,
+    solver: str = "faer-cholesky",
+    ordering: str = "auto",
+    bonded: bool = False,
+    stabilization: float = 0.0,
+) -> dict:
+    """The elasto-plastic curve of a cell with frictional contacts under the macroscopic
+    strain ``strain`` ({"e11": 0.01} or "e11=0.01"), ramped over ``steps`` increments (with
+    ``unload``: back to zero and up again): the document of ``fibercell curve --json``, plus
+    arrays over the increments — ``strain`` and ``resultant`` (n × 6), ``dissipated`` and
+    ``equilibrium_residual`` (n)."""
+    doc = json.loads(
+        _fibercell.curve_json(
+            model,
+            _strain_text(strain),
+            steps=steps,
+            unload=unload,
+            solver=solver,
+            ordering=ordering,
+            bonded=bonded,
+            stabilization=stabilization,
+        )
+    )
+    points = doc["points"]
+    doc["arrays"] = {
+        "strain": np.array([p["strain"] for p in points], dtype=float).reshape(-1, 6),
+        "resultant": np.array([p["resultant"] for p in points], dtype=float).reshape(-1, 6),
+        "dissipated": np.array([p["dissipated"] for p in points], dtype=float),
+        "equilibrium_residual": np.array(
+            [p["equilibrium_residual"] for p in points], dtype=float
+        ),
+    }
+    return doc
+
+
+def _csc_arrays(a: Any) -> Tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    """(n, indptr, indices, data) of a square scipy.sparse matrix, sorted and summed."""
+    try:
+        shape = a.shape
+        csc = a.tocsc(copy=True)
+    except AttributeError as e:
+        raise FibercellError(f"expected a scipy.sparse matrix, got {type(a).__name__}") from e
+    if len(shape) != 2 or shape[0] != shape[1]:
+        raise FibercellError(f"the matrix must be square, not {shape}")
+    csc.sum_duplicates()
+    csc.sort_indices()
+    return (
+        int(shape[0]),
+        np.ascontiguousarray(csc.indptr, dtype=np.int64),
+        np.ascontiguousarray(csc.indices, dtype=np.int64),
+        np.ascontiguousarray(csc.data, dtype=np.float64),
+    )
+
+
+class SparseSolver:
+    """The sparse solver layer: one backend ("faer-cholesky", "faer-lu", "cg", "cholmod" in a
+    build with it) and one fill-reducing ordering ("auto", "amd", "nd", "natural").
+    ``factorize`` analyzes a new sparsity pattern and factorizes; ``solve`` may then be called
+    for any number of right-hand sides."""
+
+    def __init__(self, solver: str = "faer-cholesky", ordering: str = "auto") -> None:
+        self._raw = _fibercell.SparseSolver(solver=solver, ordering=ordering)
+
+    @property
+    def backend(self) -> str:
+        """The backend's name."""
+        return self._raw.backend
+
+    def factorize(self, a: Any) -> None:
+        """Analyzes (when its pattern is new) and factorizes the square scipy.sparse ``a``
+        (both triangles of a symmetric matrix)."""
+        self._raw.factorize(*_csc_arrays(a))
+
+    def solve(self, b: np.ndarray) -> Tuple[np.ndarray, float]:
+        """x with A x = b for the factorized A, and the solve's backward error (an error
+        above 1e-8 raises)."""
+        return self._raw.solve(np.ascontiguousarray(b, dtype=np.float64))
+
+
+def solve(
+    a: Any,
+    b: Optional[np.ndarray] = None,
+    solver: str = "faer-cholesky",
+    ordering: str = "auto",
+) -> Tuple[np.ndarray, float]:
+    """x with A x = b for a square scipy.sparse A (both triangles of a symmetric matrix) and a
+    NumPy b (default A·1, whose solution is all ones), by the backend ``solver`` with the
+    ordering ``ordering``; returns x and the solve's backward error."""
+    s = SparseSolver(solver=solver, ordering=ordering)
+    s.factorize(a)
+    if b is None:
+        b = a @ np.ones(a.shape[1])
+    return s.solve(b)

@@ -1,0 +1,372 @@
+//! The Python extension `fibercell._fibercell`: models, the generators, `homogenize`, `curve`
+//! and the sparse solver layer. Results cross as the JSON the CLI prints (the same serializer,
+//! so the same digits); the Python package (`python/fibercell/__init__.py`) turns them into
+//! dictionaries with NumPy arrays. Every call that computes releases the GIL; every error is a
+//! `fibercell.FibercellError` (a `ValueError`) with the library's message, the text the CLI
+//! prints after `error:`.
+
+use fibercell::homogenize::{elasto_plastic_curve, homogenize_elastic, CurveOptions};
+use fibercell::io;
+use fibercell::model::ModelDescription;
+use fibercell::solve::{IncrementalOptions, SolveOptions, SolverConfig, SolverKind};
+use fibercell_solver::{CscMatrix, LinearSolver, Ordering};
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+pyo3::create_exception!(
+    _fibercell,
+    FibercellError,
+    PyValueError,
+    "An error of fibercell: malformed or invalid input, a singular system, a failed solve."
+);
+
+/// The library's error as a Python exception, its message as the CLI prints it.
+fn error(e: impl std::fmt::Display) -> PyErr {
+    FibercellError::new_err(e.to_string())
+}
+
+/// The solver options of a backend and ordering given by name.
+fn solve_options(solver: &str, ordering: &str) -> PyResult<SolveOptions> {
+    let kind: SolverKind = solver.parse().map_err(error)?;
+    if !kind.is_available() {
+        return Err(error(format!(
+            "solver \"{solver}\" is not in this build (CHOLMOD needs the cholmod feature)"
+        )));
+    }
+    Ok(SolveOptions {
+        solver: kind,
+        ordering: Ordering::parse(ordering).map_err(error)?,
+        ..SolveOptions::default()
+    })
+}
+
+fn to_json<T: serde::Serialize>(value: &T) -> PyResult<String> {
+    serde_json::to_string(value).map_err(error)
+}
+
+/// A validated model: fibers, nodes, materials, contacts, and a periodic cell or supports.
+#[pyclass(frozen, module = "fibercell")]
+struct Model {
+    description: ModelDescription,
+    model: fibercell::Model,
+}
+
+impl Model {
+    fn new(description: ModelDescription) -> PyResult<Self> {
+        let model = fibercell::Model::from_description(&description).map_err(error)?;
+        Ok(Model { description, model })
+    }
+}
+
+#[pymethods]
+impl Model {
+    /// Reads a model file: .toml, .json or Abaqus .inp.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let d = py.detach(|| io::read_description(&path)).map_err(error)?;
+        Model::new(d)
+    }
+
+    /// A model from the text of a TOML model file.
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<Self> {
+        Model::new(io::parse_toml(text, "<toml string>").map_err(error)?)
+    }
+
+    /// A model from the text of a JSON model file (also what `fibercell.Model.from_dict`
+    /// passes).
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        Model::new(io::parse_json(text, "<json string>").map_err(error)?)
+    }
+
+    /// A model from the text of an Abaqus input file.
+    #[staticmethod]
+    fn from_inp(text: &str) -> PyResult<Self> {
+        Model::new(io::parse_abaqus(text, "<inp string>").map_err(error)?)
+    }
+
+    /// The model as the text of a JSON model file.
+    fn to_json(&self) -> PyResult<String> {
+        io::to_json(&self.description).map_err(error)
+    }
+
+    /// The model as the text of a TOML model file.
+    fn to_toml(&self) -> PyResult<String> {
+        io::to_toml(&self.description).map_err(error)
+    }
+
+    /// Writes the model in the format of the path's extension (.toml, .json, .inp, .vtp,
+    /// .vtu, .pvd), atomically.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let d = &self.description;
+        py.detach(|| io::write_model(&path, d, &io::WriteOptions::default()))
+            .map(|_| ())
+            .map_err(error)
+    }
+
+    /// Number of nodes.
+    #[getter]
+    fn nodes(&self) -> usize {
+        self.model.nodes.len()
+    }
+
+    /// Number of fibers.
+    #[getter]
+    fn fibers(&self) -> usize {
+        self.model.fibers.len()
+    }
+
+    /// Number of beam elements.
+    #[getter]
+    fn elements(&self) -> usize {
+        self.model.elements().len()
+    }
+
+    /// Whether the model is a periodic cell.
+    #[getter]
+    fn is_cell(&self) -> bool {
+        self.model.cell.is_some()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "fibercell.Model({:?}: {} fibers, {} elements{})",
+            self.description.name.as_deref().unwrap_or(""),
+            self.model.fibers.len(),
+            self.model.elements().len(),
+            if self.model.cell.is_some() {
+                ", periodic cell"
+            } else {
+                ""
+            }
+        )
+    }
+}
+
+/// A generated cell from the JSON of a parameter set tagged by `family` (woven, geotextile,
+/// knitted, nonwoven), as in `fixtures/cells/*.params.toml`; the fields not given keep the
+/// generator's defaults.
+#[pyfunction]
+fn generate_json(py: Python<'_>, params: &str) -> PyResult<Model> {
+    use fibercell::generate::{CellParams, Geotextile, Knit, NonWoven, Weave};
+    let bad = |e: serde_json::Error| error(format!("generator parameters: {e}"));
+    let given: serde_json::Value = serde_json::from_str(params).map_err(bad)?;
+    let defaults = match given.get("family").and_then(|f| f.as_str()) {
+        Some("woven") => CellParams::Woven(Weave::default()),
+        Some("geotextile") => CellParams::Geotextile(Geotextile::default()),
+        Some("knitted") => CellParams::Knitted(Knit::default()),
+        Some("nonwoven") => CellParams::Nonwoven(NonWoven::default()),
+        other => {
+            return Err(error(format!(
+                "generator parameters: family {other:?} is not woven, geotextile, knitted or \
+                 nonwoven"
+            )))
+        }
+    };
+    let mut merged = serde_json::to_value(&defaults).map_err(bad)?;
+    if let (Some(m), Some(g)) = (merged.as_object_mut(), given.as_object()) {
+        for (k, v) in g {
+            m.insert(k.clone(), v.clone());
+        }
+    }
+    let params: CellParams = serde_json::from_value(merged).map_err(bad)?;
+    let d = py.detach(|| params.generate()).map_err(error)?;
+    Model::new(d)
+}
+
+/// `homogenize`: the elastic ABD of a cell and its moduli, as the JSON the CLI prints.
+#[pyfunction]
+#[pyo3(signature = (model, solver = "faer-cholesky", ordering = "auto"))]
+fn homogenize_json(
+    py: Python<'_>,
+    model: &Model,
+    solver: &str,
+    ordering: &str,
+) -> PyResult<String> {
+    let options = solve_options(solver, ordering)?;
+    let m = &model.model;
+    let h = py
+        .detach(|| homogenize_elastic(m, &options))
+        .map_err(error)?;
+    to_json(&h)
+}
+
+/// `curve`: the elasto-plastic curve of a cell under `strain` ("e11=0.01,g12=0.002"), as the
+/// JSON the CLI prints.
+#[pyfunction]
+#[pyo3(signature = (model, strain, steps = 100, unload = false, solver = "faer-cholesky",
+                    ordering = "auto", bonded = false, stabilization = 0.0))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments
+fn curve_json(
+    py: Python<'_>,
+    model: &Model,
+    strain: &str,
+    steps: usize,
+    unload: bool,
+    solver: &str,
+    ordering: &str,
+    bonded: bool,
+    stabilization: f64,
+) -> PyResult<String> {
+    let strain = fibercell::cell::parse_macro_strain(strain).map_err(error)?;
+    let opts = CurveOptions {
+        strain,
+        steps,
+        unload,
+        incremental: IncrementalOptions {
+            solve: solve_options(solver, ordering)?,
+            bonded,
+            stabilization,
+            ..IncrementalOptions::default()
+        },
+    };
+    let m = &model.model;
+    let c = py
+        .detach(|| elasto_plastic_curve(m, &opts))
+        .map_err(error)?;
+    to_json(&c)
+}
+
+/// A square CSC matrix from NumPy arrays (both triangles of a symmetric matrix).
+fn csc(
+    n: usize,
+    indptr: &PyReadonlyArray1<'_, i64>,
+    indices: &PyReadonlyArray1<'_, i64>,
+    data: &PyReadonlyArray1<'_, f64>,
+) -> PyResult<CscMatrix> {
+    let index = |v: &i64, what: &str| {
+        usize::try_from(*v).map_err(|_| error(format!("negative {what} {v} in the CSC arrays")))
+    };
+    let col_ptr = indptr
+        .as_slice()?
+        .iter()
+        .map(|v| index(v, "column pointer"))
+        .collect::<PyResult<Vec<usize>>>()?;
+    let row_idx = indices
+        .as_slice()?
+        .iter()
+        .map(|v| index(v, "row index"))
+        .collect::<PyResult<Vec<usize>>>()?;
+    CscMatrix::new(n, n, col_ptr, row_idx, data.as_slice()?.to_vec()).map_err(error)
+}
+
+/// The sparse solver layer: one backend (faer-cholesky, faer-lu, cg, cholmod) with one
+/// ordering (auto, amd, nd, natural); `factorize` analyzes first when the pattern is new.
+#[pyclass(module = "fibercell")]
+struct SparseSolver {
+    inner: Mutex<SolverState>,
+}
+
+struct SolverState {
+    solver: Box<dyn LinearSolver>,
+    matrix: Option<CscMatrix>,
+}
+
+#[pymethods]
+impl SparseSolver {
+    #[new]
+    #[pyo3(signature = (solver = "faer-cholesky", ordering = "auto"))]
+    fn new(solver: &str, ordering: &str) -> PyResult<Self> {
+        let options = solve_options(solver, ordering)?;
+        let config = SolverConfig {
+            kind: options.solver,
+            ordering: options.ordering,
+            ..SolverConfig::default()
+        };
+        Ok(SparseSolver {
+            inner: Mutex::new(SolverState {
+                solver: config.build().map_err(error)?,
+                matrix: None,
+            }),
+        })
+    }
+
+    /// Analyzes (when the pattern is new) and factorizes the n × n CSC matrix given by its
+    /// arrays.
+    fn factorize(
+        &self,
+        py: Python<'_>,
+        n: usize,
+        indptr: PyReadonlyArray1<'_, i64>,
+        indices: PyReadonlyArray1<'_, i64>,
+        data: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<()> {
+        let a = csc(n, &indptr, &indices, &data)?;
+        let mut state = self.inner.lock().map_err(error)?;
+        let state = &mut *state;
+        py.detach(|| {
+            let same_pattern = state.matrix.as_ref().is_some_and(|m| {
+                m.as_ref().col_ptr() == a.as_ref().col_ptr()
+                    && m.as_ref().row_idx() == a.as_ref().row_idx()
+            });
+            if !same_pattern {
+                state.solver.analyze(a.as_ref())?;
+            }
+            state.solver.factorize(a.as_ref())?;
+            state.matrix = Some(a);
+            Ok::<_, fibercell_solver::SolverError>(())
+        })
+        .map_err(error)
+    }
+
+    /// x with A x = b for the factorized A, checked by its backward error; returns (x, the
+    /// backward error).
+    fn solve<'py>(
+        &self,
+        py: Python<'py>,
+        b: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
+        let b = b.as_slice()?.to_vec();
+        let mut state = self.inner.lock().map_err(error)?;
+        let state = &mut *state;
+        let a = state
+            .matrix
+            .as_ref()
+            .ok_or_else(|| error("solve before factorize: no matrix"))?;
+        if b.len() != a.as_ref().nrows() {
+            return Err(error(format!(
+                "right-hand side of length {} for a matrix of order {}",
+                b.len(),
+                a.as_ref().nrows()
+            )));
+        }
+        let solver = &mut state.solver;
+        let (x, backward) = py
+            .detach(|| {
+                let mut x = b.clone();
+                solver.solve_in_place(&mut x, 1)?;
+                let backward = fibercell_solver::backward_error(a.as_ref(), &x, &b);
+                Ok::<_, fibercell_solver::SolverError>((x, backward))
+            })
+            .map_err(error)?;
+        if !(backward <= 1e-8) {
+            return Err(error(format!(
+                "the solve's backward error is {backward:e}: the matrix is singular or breaks \
+                 the backend's assumptions (try solver=\"faer-lu\")"
+            )));
+        }
+        Ok((PyArray1::from_vec(py, x), backward))
+    }
+
+    /// The backend's name.
+    #[getter]
+    fn backend(&self) -> PyResult<&'static str> {
+        Ok(self.inner.lock().map_err(error)?.solver.name())
+    }
+}
+
+#[pymodule]
+fn _fibercell(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("FibercellError", m.py().get_type::<FibercellError>())?;
+    m.add_class::<Model>()?;
+    m.add_class::<SparseSolver>()?;
+    m.add_function(wrap_pyfunction!(generate_json, m)?)?;
+    m.add_function(wrap_pyfunction!(homogenize_json, m)?)?;
+    m.add_function(wrap_pyfunction!(curve_json, m)?)?;
+    Ok(())
+}
