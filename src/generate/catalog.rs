@@ -27,6 +27,32 @@ impl CellParams {
         crate::io::read_toml_file(path)
     }
 
+    /// The parameters of a JSON object tagged by `family` whose other fields override the
+    /// family's defaults (what the Python and C bindings take: only the fields one changes).
+    pub fn from_json_with_defaults(text: &str) -> Result<Self, Error> {
+        let bad = |e: serde_json::Error| Error::InvalidOption(format!("generator parameters: {e}"));
+        let given: serde_json::Value = serde_json::from_str(text).map_err(bad)?;
+        let defaults = match given.get("family").and_then(|f| f.as_str()) {
+            Some("woven") => CellParams::Woven(Weave::default()),
+            Some("geotextile") => CellParams::Geotextile(Geotextile::default()),
+            Some("knitted") => CellParams::Knitted(Knit::default()),
+            Some("nonwoven") => CellParams::Nonwoven(NonWoven::default()),
+            other => {
+                return Err(Error::InvalidOption(format!(
+                    "generator parameters: family {other:?} is not woven, geotextile, knitted \
+                     or nonwoven"
+                )))
+            }
+        };
+        let mut merged = serde_json::to_value(&defaults).map_err(bad)?;
+        if let (Some(m), Some(g)) = (merged.as_object_mut(), given.as_object()) {
+            for (k, v) in g {
+                m.insert(k.clone(), v.clone());
+            }
+        }
+        serde_json::from_value(merged).map_err(bad)
+    }
+
     /// The cell.
     pub fn generate(&self) -> Result<ModelDescription, Error> {
         match self {
@@ -89,4 +115,32 @@ pub fn reference_results(d: &ModelDescription) -> Result<ReferenceResults, Error
         abd: h.abd,
         cell_digest: cell_digest(d)?,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Given fields override the defaults, the others keep them; an unknown family or field
+    /// type is an error naming the parameters.
+    #[test]
+    fn json_parameters_override_the_defaults() {
+        let p =
+            CellParams::from_json_with_defaults(r#"{"family": "knitted", "wales": 3}"#).unwrap();
+        let CellParams::Knitted(k) = p else {
+            panic!("not a knit: {p:?}")
+        };
+        assert_eq!(k.wales, 3);
+        assert_eq!(k.courses, Knit::default().courses);
+        for bad in [
+            r#"{"family": "crochet"}"#,
+            r#"{"family": "knitted", "wales": "x"}"#,
+            "[",
+        ] {
+            let e = CellParams::from_json_with_defaults(bad)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("generator parameters"), "{e}");
+        }
+    }
 }

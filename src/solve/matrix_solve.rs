@@ -88,3 +88,129 @@ pub fn solve_matrix(
         },
     ))
 }
+
+/// The largest backward error a [`MatrixSolver`] solve accepts.
+pub const MATRIX_SOLVE_BACKWARD_ERROR: f64 = 1e-8;
+
+/// A backend with its last matrix, for callers with their own matrices (the Python and C
+/// bindings): factorize any number of matrices — the symbolic analysis runs again only when
+/// the pattern changes — and solve any number of right-hand sides, each checked by its
+/// normwise backward error.
+pub struct MatrixSolver {
+    solver: Box<dyn fibercell_solver::LinearSolver>,
+    matrix: Option<fibercell_solver::CscMatrix>,
+}
+
+impl MatrixSolver {
+    /// The backend of `config`.
+    pub fn new(config: &SolverConfig) -> Result<Self, Error> {
+        Ok(MatrixSolver {
+            solver: config.build()?,
+            matrix: None,
+        })
+    }
+
+    /// The backend's name.
+    pub fn backend(&self) -> &'static str {
+        self.solver.name()
+    }
+
+    /// The order of the last factorized matrix (`None` before the first).
+    pub fn order(&self) -> Option<usize> {
+        self.matrix.as_ref().map(|m| m.as_ref().nrows())
+    }
+
+    /// Analyzes `a` when its pattern differs from the last matrix's, and factorizes it.
+    pub fn factorize(&mut self, a: fibercell_solver::CscMatrix) -> Result<(), Error> {
+        let same_pattern = self.matrix.as_ref().is_some_and(|m| {
+            let (m, a) = (m.as_ref(), a.as_ref());
+            m.nrows() == a.nrows() && m.col_ptr() == a.col_ptr() && m.row_idx() == a.row_idx()
+        });
+        // A failed factorization leaves no matrix to solve with.
+        self.matrix = None;
+        if !same_pattern {
+            self.solver.analyze(a.as_ref())?;
+        }
+        self.solver.factorize(a.as_ref())?;
+        self.matrix = Some(a);
+        Ok(())
+    }
+
+    /// x with A x = b for the last factorized A, and its backward error ‖Ax − b‖∞/(‖A‖∞‖x‖∞ +
+    /// ‖b‖∞); an error above [`MATRIX_SOLVE_BACKWARD_ERROR`] (a singular matrix, or one that
+    /// breaks the backend's assumptions) is refused.
+    pub fn solve(&mut self, b: &[f64]) -> Result<(Vec<f64>, f64), Error> {
+        let a = self
+            .matrix
+            .as_ref()
+            .ok_or_else(|| Error::InvalidOption("solve before factorize: no matrix".into()))?;
+        if b.len() != a.as_ref().nrows() {
+            return Err(Error::InvalidOption(format!(
+                "right-hand side of length {} for a matrix of order {}",
+                b.len(),
+                a.as_ref().nrows()
+            )));
+        }
+        let (x, report) = solve_checked(self.solver.as_mut(), a.as_ref(), b, 1)?;
+        let e = report.backward_error;
+        if !(e <= MATRIX_SOLVE_BACKWARD_ERROR) {
+            return Err(Error::InvalidOption(format!(
+                "the solve's backward error is {e:e}: the matrix is singular or breaks the \
+                 backend's assumptions (try the faer-lu backend)"
+            )));
+        }
+        Ok((x, e))
+    }
+}
+
+#[cfg(test)]
+mod matrix_solver_tests {
+    use super::*;
+    use crate::solve::SolverKind;
+    use fibercell_solver::CscMatrix;
+
+    /// [[4,1,0],[1,3,1],[0,1,2]] scaled by `s`, both triangles.
+    fn tridiagonal(s: f64) -> CscMatrix {
+        let v = [4.0, 1.0, 1.0, 3.0, 1.0, 1.0, 2.0].map(|x| x * s);
+        CscMatrix::new(
+            3,
+            3,
+            vec![0, 2, 5, 7],
+            vec![0, 1, 0, 1, 2, 1, 2],
+            v.to_vec(),
+        )
+        .unwrap()
+    }
+
+    /// Refactorized values give the new solution (A x = (6, 10, 8) s: x = (1, 2, 3)); a
+    /// singular matrix, a wrong length and a solve before any factorization are errors.
+    #[test]
+    fn a_matrix_solver_refactorizes_and_refuses_what_it_cannot_solve() {
+        for kind in [SolverKind::FaerCholesky, SolverKind::FaerLu] {
+            let mut s = MatrixSolver::new(&SolverConfig::new(kind)).unwrap();
+            assert!(s.solve(&[1.0; 3]).is_err(), "{kind}: no matrix yet");
+            for scale in [1.0, 2.0] {
+                s.factorize(tridiagonal(scale)).unwrap();
+                let b = [6.0, 10.0, 8.0].map(|x| x * scale);
+                let (x, e) = s.solve(&b).unwrap();
+                assert!(e <= 1e-15, "{kind}: backward error {e}");
+                for (i, xi) in x.iter().enumerate() {
+                    assert!((xi - (i + 1) as f64).abs() <= 1e-13, "{kind}: {x:?}");
+                }
+            }
+            assert_eq!(s.order(), Some(3));
+            assert!(s.solve(&[1.0; 2]).is_err(), "{kind}: wrong length");
+            let singular =
+                CscMatrix::new(2, 2, vec![0, 2, 4], vec![0, 1, 0, 1], vec![1.0; 4]).unwrap();
+            let refused = s
+                .factorize(singular)
+                .and_then(|_| s.solve(&[1.0, 2.0]).map(|_| ()));
+            assert!(refused.is_err(), "{kind}: a singular matrix was solved");
+            assert_eq!(
+                s.order(),
+                None,
+                "{kind}: a failed factorization keeps no matrix"
+            );
+        }
+    }
+}

@@ -24,7 +24,9 @@ pub use incremental::{
 };
 pub use job_system::{job_system, JobSystem};
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
-pub use matrix_solve::{solve_matrix, MatrixSolveReport};
+pub use matrix_solve::{
+    solve_matrix, MatrixSolveReport, MatrixSolver, MATRIX_SOLVE_BACKWARD_ERROR,
+};
 pub use reduced::ReducedSystem;
 pub(crate) use static_solve::{check_backward_error, locate};
 pub use static_solve::{solve_static, SolveOptions, SolveSummary, StaticSolution, Timings};

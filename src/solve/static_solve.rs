@@ -25,6 +25,23 @@ pub struct SolveOptions {
 }
 
 impl SolveOptions {
+    /// The default options with the backend and ordering named as on the CLI (`faer-cholesky`,
+    /// `faer-lu`, `cg`, `cholmod`; `auto`, `amd`, `nd`, `natural`); a backend this build lacks is
+    /// an error.
+    pub fn by_name(solver: &str, ordering: &str) -> Result<Self, Error> {
+        let kind: SolverKind = solver.parse().map_err(Error::InvalidOption)?;
+        if !kind.is_available() {
+            return Err(Error::InvalidOption(format!(
+                "solver \"{solver}\" is not in this build (CHOLMOD needs the cholmod feature)"
+            )));
+        }
+        Ok(SolveOptions {
+            solver: kind,
+            ordering: Ordering::parse(ordering).map_err(Error::InvalidOption)?,
+            ..SolveOptions::default()
+        })
+    }
+
     /// The backend configuration of these options for a system whose node blocks start at
     /// `node_blocks` (the one place every job builds its [`SolverConfig`]).
     pub fn solver_config(&self, node_blocks: Vec<usize>) -> SolverConfig {

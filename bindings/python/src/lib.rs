@@ -8,8 +8,8 @@
 use fibercell::homogenize::{elasto_plastic_curve, homogenize_elastic, CurveOptions};
 use fibercell::io;
 use fibercell::model::ModelDescription;
-use fibercell::solve::{IncrementalOptions, SolveOptions, SolverConfig, SolverKind};
-use fibercell_solver::{CscMatrix, LinearSolver, Ordering};
+use fibercell::solve::{IncrementalOptions, MatrixSolver, SolveOptions, SolverConfig};
+use fibercell_solver::CscMatrix;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -30,17 +30,7 @@ fn error(e: impl std::fmt::Display) -> PyErr {
 
 /// The solver options of a backend and ordering given by name.
 fn solve_options(solver: &str, ordering: &str) -> PyResult<SolveOptions> {
-    let kind: SolverKind = solver.parse().map_err(error)?;
-    if !kind.is_available() {
-        return Err(error(format!(
-            "solver \"{solver}\" is not in this build (CHOLMOD needs the cholmod feature)"
-        )));
-    }
-    Ok(SolveOptions {
-        solver: kind,
-        ordering: Ordering::parse(ordering).map_err(error)?,
-        ..SolveOptions::default()
-    })
+    SolveOptions::by_name(solver, ordering).map_err(error)
 }
 
 fn to_json<T: serde::Serialize>(value: &T) -> PyResult<String> {
@@ -152,28 +142,7 @@ impl Model {
 /// generator's defaults.
 #[pyfunction]
 fn generate_json(py: Python<'_>, params: &str) -> PyResult<Model> {
-    use fibercell::generate::{CellParams, Geotextile, Knit, NonWoven, Weave};
-    let bad = |e: serde_json::Error| error(format!("generator parameters: {e}"));
-    let given: serde_json::Value = serde_json::from_str(params).map_err(bad)?;
-    let defaults = match given.get("family").and_then(|f| f.as_str()) {
-        Some("woven") => CellParams::Woven(Weave::default()),
-        Some("geotextile") => CellParams::Geotextile(Geotextile::default()),
-        Some("knitted") => CellParams::Knitted(Knit::default()),
-        Some("nonwoven") => CellParams::Nonwoven(NonWoven::default()),
-        other => {
-            return Err(error(format!(
-                "generator parameters: family {other:?} is not woven, geotextile, knitted or \
-                 nonwoven"
-            )))
-        }
-    };
-    let mut merged = serde_json::to_value(&defaults).map_err(bad)?;
-    if let (Some(m), Some(g)) = (merged.as_object_mut(), given.as_object()) {
-        for (k, v) in g {
-            m.insert(k.clone(), v.clone());
-        }
-    }
-    let params: CellParams = serde_json::from_value(merged).map_err(bad)?;
+    let params = fibercell::generate::CellParams::from_json_with_defaults(params).map_err(error)?;
     let d = py.detach(|| params.generate()).map_err(error)?;
     Model::new(d)
 }
@@ -258,12 +227,7 @@ fn csc(
 /// ordering (auto, amd, nd, natural); `factorize` analyzes first when the pattern is new.
 #[pyclass(module = "fibercell")]
 struct SparseSolver {
-    inner: Mutex<SolverState>,
-}
-
-struct SolverState {
-    solver: Box<dyn LinearSolver>,
-    matrix: Option<CscMatrix>,
+    inner: Mutex<MatrixSolver>,
 }
 
 #[pymethods]
@@ -278,10 +242,7 @@ impl SparseSolver {
             ..SolverConfig::default()
         };
         Ok(SparseSolver {
-            inner: Mutex::new(SolverState {
-                solver: config.build().map_err(error)?,
-                matrix: None,
-            }),
+            inner: Mutex::new(MatrixSolver::new(&config).map_err(error)?),
         })
     }
 
@@ -296,21 +257,9 @@ impl SparseSolver {
         data: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<()> {
         let a = csc(n, &indptr, &indices, &data)?;
-        let mut state = self.inner.lock().map_err(error)?;
-        let state = &mut *state;
-        py.detach(|| {
-            let same_pattern = state.matrix.as_ref().is_some_and(|m| {
-                m.as_ref().col_ptr() == a.as_ref().col_ptr()
-                    && m.as_ref().row_idx() == a.as_ref().row_idx()
-            });
-            if !same_pattern {
-                state.solver.analyze(a.as_ref())?;
-            }
-            state.solver.factorize(a.as_ref())?;
-            state.matrix = Some(a);
-            Ok::<_, fibercell_solver::SolverError>(())
-        })
-        .map_err(error)
+        let mut solver = self.inner.lock().map_err(error)?;
+        let solver = &mut *solver;
+        py.detach(|| solver.factorize(a)).map_err(error)
     }
 
     /// x with A x = b for the factorized A, checked by its backward error; returns (x, the
@@ -321,41 +270,16 @@ impl SparseSolver {
         b: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
         let b = b.as_slice()?.to_vec();
-        let mut state = self.inner.lock().map_err(error)?;
-        let state = &mut *state;
-        let a = state
-            .matrix
-            .as_ref()
-            .ok_or_else(|| error("solve before factorize: no matrix"))?;
-        if b.len() != a.as_ref().nrows() {
-            return Err(error(format!(
-                "right-hand side of length {} for a matrix of order {}",
-                b.len(),
-                a.as_ref().nrows()
-            )));
-        }
-        let solver = &mut state.solver;
-        let (x, backward) = py
-            .detach(|| {
-                let mut x = b.clone();
-                solver.solve_in_place(&mut x, 1)?;
-                let backward = fibercell_solver::backward_error(a.as_ref(), &x, &b);
-                Ok::<_, fibercell_solver::SolverError>((x, backward))
-            })
-            .map_err(error)?;
-        if !(backward <= 1e-8) {
-            return Err(error(format!(
-                "the solve's backward error is {backward:e}: the matrix is singular or breaks \
-                 the backend's assumptions (try solver=\"faer-lu\")"
-            )));
-        }
+        let mut solver = self.inner.lock().map_err(error)?;
+        let solver = &mut *solver;
+        let (x, backward) = py.detach(|| solver.solve(&b)).map_err(error)?;
         Ok((PyArray1::from_vec(py, x), backward))
     }
 
     /// The backend's name.
     #[getter]
     fn backend(&self) -> PyResult<&'static str> {
-        Ok(self.inner.lock().map_err(error)?.solver.name())
+        Ok(self.inner.lock().map_err(error)?.backend())
     }
 }
 
