@@ -227,3 +227,64 @@ fn models_that_cannot_be_written_are_errors() {
     d.nodes[0].x[0] = f64::NAN;
     assert!(matches!(to_abaqus(&d), Err(Error::Model(_))));
 }
+
+/// A fiber with an element along each of the 13 axis and diagonal directions the exporter
+/// tries first still gets a section direction n1 off all its elements (from the fallback
+/// search over the sphere), which the importer's check accepts.
+#[test]
+fn a_fiber_along_every_axis_and_diagonal_still_gets_a_section_direction() {
+    let r2 = 0.5f64.sqrt();
+    let r3 = (1.0f64 / 3.0).sqrt();
+    let mut steps = vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+        for sign in [1.0, -1.0] {
+            let mut d = [0.0; 3];
+            d[i] = r2;
+            d[j] = sign * r2;
+            steps.push(d);
+        }
+    }
+    for (sy, sz) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+        steps.push([r3, sy * r3, sz * r3]);
+    }
+    let mut text = String::from(
+        "[[materials]]\nname = \"m\"\nyoung = 1e9\npoisson = 0.3\n\
+         [[supports]]\nnode = 1\ndofs = [\"all\"]\n",
+    );
+    let mut x = [0.0f64; 3];
+    text += "[[nodes]]\nid = 1\nx = [0.0, 0.0, 0.0]\n";
+    for (k, d) in steps.iter().enumerate() {
+        x = [0, 1, 2].map(|c| x[c] + 0.1 * d[c]);
+        text += &format!(
+            "[[nodes]]\nid = {}\nx = [{:?}, {:?}, {:?}]\n",
+            k + 2,
+            x[0],
+            x[1],
+            x[2]
+        );
+    }
+    let ids: Vec<String> = (1..=steps.len() + 1).map(|i| i.to_string()).collect();
+    text += &format!(
+        "[[fibers]]\nid = 1\nnodes = [{}]\nradius = 0.001\nmaterial = \"m\"\n",
+        ids.join(", ")
+    );
+    let d: ModelDescription = toml::from_str(&text).unwrap();
+    let inp = to_abaqus(&d).unwrap();
+    let back = parse_abaqus(&inp, "every direction").expect("n1 accepted on import");
+    assert_eq!(back.fibers.len(), 1);
+    let n1_line = inp
+        .lines()
+        .skip_while(|l| !l.starts_with("*BEAM SECTION"))
+        .nth(2)
+        .unwrap();
+    let n1: Vec<f64> = n1_line
+        .split(',')
+        .map(|v| v.trim().parse().unwrap())
+        .collect();
+    assert!(
+        !steps
+            .iter()
+            .any(|s| (0..3).all(|c| (s[c] - n1[c]).abs() < 1e-12)),
+        "n1 {n1:?} is one of the first candidates"
+    );
+}

@@ -150,7 +150,7 @@ pub fn to_inp(d: &ModelDescription, opts: &InpOptions) -> Result<String, Error> 
         );
         let size = if calculix { 2.0 * f.radius } else { f.radius };
         let _ = writeln!(w, "{}", inp_number(size));
-        let n1 = section_direction(&model, f).map(inp_number);
+        let n1 = section_direction(&model, f)?.map(inp_number);
         let _ = writeln!(w, "{}, {}, {}", n1[0], n1[1], n1[2]);
     }
     write_materials(w, d)?;
@@ -289,7 +289,10 @@ fn dof_ranges(sets: &[DofSet]) -> Vec<(usize, usize)> {
 /// axes and the ten diagonals (normalized ±1 combinations): its largest |cos| to an element
 /// is the smallest. A fiber bent along all three axes (up, across, along y) has every axis
 /// parallel to some element, and Abaqus refuses an n1 along an element; a diagonal then serves.
-fn section_direction(model: &Model, f: &crate::model::FiberSpec) -> [f64; 3] {
+/// Should every one of them lie within 1° of some element, 2,000 directions spread over the
+/// sphere are searched; a fiber with an element within 10⁻⁴ rad of each is an error (no n1
+/// for one section exists).
+fn section_direction(model: &Model, f: &crate::model::FiberSpec) -> Result<[f64; 3], Error> {
     let pos = |id: u64| model.node_index(id).map_or([0.0; 3], |i| model.nodes[i].x);
     let axes: Vec<[f64; 3]> = f
         .nodes
@@ -319,10 +322,35 @@ fn section_direction(model: &Model, f: &crate::model::FiberSpec) -> [f64; 3] {
             .map(|t| (t[0] * d[0] + t[1] * d[1] + t[2] * d[2]).abs())
             .fold(0.0f64, f64::max)
     };
-    candidates
-        .into_iter()
-        .min_by(|a, b| alignment(a).total_cmp(&alignment(b)))
-        .unwrap_or([0.0, 0.0, 1.0])
+    let best = |candidates: Vec<[f64; 3]>| {
+        candidates
+            .into_iter()
+            .map(|d| (alignment(&d), d))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap_or((0.0, [0.0, 0.0, 1.0]))
+    };
+    let (mut worst, mut n1) = best(candidates);
+    if worst > 1.0f64.to_radians().cos() {
+        // A Fibonacci lattice on the half sphere (n1 and −n1 are the same section plane).
+        let golden = std::f64::consts::PI * (3.0 - 5.0f64.sqrt());
+        let lattice: Vec<[f64; 3]> = (0..2000)
+            .map(|k| {
+                let z = 1.0 - (k as f64 + 0.5) / 2000.0;
+                let r = (1.0 - z * z).sqrt();
+                let phi = golden * k as f64;
+                [r * phi.cos(), r * phi.sin(), z]
+            })
+            .collect();
+        (worst, n1) = best(lattice);
+    }
+    if worst > 1.0 - 0.5e-8 {
+        return Err(Error::InvalidOption(format!(
+            "Abaqus export: fiber {} has elements along every direction, so no beam-section \
+             direction n1 is off all of them: split the fiber",
+            f.id
+        )));
+    }
+    Ok(n1)
 }
 
 /// The number of the first strain-driver node: after the model's nodes.
