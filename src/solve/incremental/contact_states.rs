@@ -25,6 +25,10 @@ pub(super) struct ContactStates {
     pub switches: Vec<usize>,
     /// The fixed point's history in this increment.
     pub acceleration: BoundAcceleration,
+    /// The converged bounds of the increment before the last, its load factor and which
+    /// contacts slid then (for the bounds' predictor), and the last increment's load factor.
+    previous: Option<(f64, Vec<f64>, Vec<bool>)>,
+    last_alpha: Option<f64>,
     friction: Friction,
     bound_fixed_point: bool,
 }
@@ -49,6 +53,8 @@ impl ContactStates {
             },
             switches: vec![0; n],
             acceleration: BoundAcceleration::default(),
+            previous: None,
+            last_alpha: None,
             friction,
             bound_fixed_point: setup.bound_fixed_point,
         }
@@ -86,6 +92,35 @@ impl ContactStates {
             direction: self.directions[i],
             k_perp: self.perpendicular[i].0,
         }
+    }
+
+    /// At the start of an increment to load factor `alpha`: the bounds of the contacts that
+    /// slid at the end of the last two increments extrapolated linearly in α from their
+    /// converged values there (the bounds follow the normal forces, smooth in α while the
+    /// states hold), so the fixed point starts second-order close instead of first-order.
+    pub fn predict_bounds(&mut self, alpha: f64) {
+        if !self.bound_fixed_point {
+            return;
+        }
+        let converged = self.bounds.clone();
+        let sliding: Vec<bool> = self
+            .states
+            .iter()
+            .map(|&s| s == ContactState::Slip)
+            .collect();
+        if let (Some((a2, b2, slid)), Some(a1)) = (&self.previous, self.last_alpha) {
+            let floor = match self.friction {
+                Friction::Coulomb { cohesion, .. } => cohesion,
+                _ => 0.0,
+            };
+            for i in (0..self.bounds.len()).filter(|&i| sliding[i] && slid[i]) {
+                self.bounds[i] = extrapolate((*a2, b2[i]), (a1, converged[i]), alpha, floor);
+            }
+        }
+        if let Some(a1) = self.last_alpha {
+            self.previous = Some((a1, converged, sliding));
+        }
+        self.last_alpha = Some(alpha);
     }
 
     /// A contact that chattered and is held in its state for the rest of the increment.
@@ -170,5 +205,32 @@ impl ContactStates {
                 && self.friction != Friction::None
                 && t.trial_norm / penalty_tangent * (t.direction - self.directions[i]).norm()
                     > direction_tol)
+    }
+}
+
+/// The value at `alpha` of the line through (α₂, b₂) and (α₁, b₁), at least `floor`; b₁ when
+/// α₁ = α₂.
+fn extrapolate((a2, b2): (f64, f64), (a1, b1): (f64, f64), alpha: f64, floor: f64) -> f64 {
+    let ratio = (alpha - a1) / (a1 - a2);
+    if ratio.is_finite() {
+        (b1 + ratio * (b1 - b2)).max(floor)
+    } else {
+        b1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::extrapolate;
+
+    /// A bound linear in α is predicted exactly, forwards and on an unloading path (α
+    /// decreasing); the cohesion floors it; equal load factors keep the last bound.
+    #[test]
+    fn bounds_are_extrapolated_along_the_load_path() {
+        let b = |a: f64| 0.2 + 3.0 * a;
+        assert!((extrapolate((0.1, b(0.1)), (0.2, b(0.2)), 0.3, 0.0) - b(0.3)).abs() < 1e-15);
+        assert!((extrapolate((0.5, b(0.5)), (0.4, b(0.4)), 0.3, 0.0) - b(0.3)).abs() < 1e-15);
+        assert_eq!(extrapolate((0.2, 1.0), (0.3, 0.5), 0.5, 0.1), 0.1);
+        assert_eq!(extrapolate((0.3, 1.0), (0.3, 0.7), 0.4, 0.0), 0.7);
     }
 }

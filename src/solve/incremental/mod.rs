@@ -212,6 +212,7 @@ impl<'a, 'h> StickSlip<'a, 'h> {
         self.factors.reference_solution = None;
         self.contacts.switches.fill(0);
         self.contacts.acceleration.restart();
+        self.contacts.predict_bounds(alpha);
         let max_iterations = self.setup.opts.max_state_iterations;
         for iteration in 1..=max_iterations {
             let mut system = self.assemble(&mut inc)?;
