@@ -173,8 +173,49 @@ enum CapacitanceFactor {
         /// it zeros, or within a contact's diagonal block the matrix's entries, unused).
         l: Vec<f64>,
     },
-    /// Otherwise I + E S by LU with partial pivoting.
-    Lu(PartialPivLu<f64>),
+    /// Otherwise each E_c = X_c Y_cᵀ of its rank r_c (a nonsymmetric Coulomb-sliding block
+    /// relative to stick has rank 2 in its three translational columns), and
+    /// I + Yᵀ S X, of order Σ r_c, by LU with partial pivoting.
+    Lu {
+        factors: Vec<RankFactors>,
+        lu: PartialPivLu<f64>,
+    },
+}
+
+/// E = X Yᵀ for a k × k block E: X = U_r Σ_r and Y = V_r of its singular value decomposition,
+/// without the singular values below 10⁻¹³ of the largest. Row-major k × r.
+struct RankFactors {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    rank: usize,
+}
+
+impl RankFactors {
+    fn of(e: &[f64], k: usize) -> Self {
+        let svd = nalgebra::DMatrix::from_row_slice(k, k, e).svd(true, true);
+        let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+            unreachable!("both singular vector sets were requested")
+        };
+        let largest = svd.singular_values.iter().fold(0.0f64, |m, &v| m.max(v));
+        let kept: Vec<usize> = (0..k)
+            .filter(|&a| largest > 0.0 && svd.singular_values[a] > 1e-13 * largest)
+            .collect();
+        let rank = kept.len();
+        let mut x = vec![0.0; k * rank];
+        let mut y = vec![0.0; k * rank];
+        for (b, &a) in kept.iter().enumerate() {
+            for i in 0..k {
+                x[i * rank + b] = u[(i, a)] * svd.singular_values[a];
+                y[i * rank + b] = v_t[(a, i)];
+            }
+        }
+        RankFactors { x, y, rank }
+    }
+}
+
+/// The rank of a k × k block E (row-major) as [`RankFactors`] keeps it.
+fn block_rank(e: &[f64], k: usize) -> usize {
+    RankFactors::of(e, k).rank
 }
 
 /// C with C Cᵀ = −E for a symmetric negative semi-definite k × k block `e` (row-major), to
@@ -202,9 +243,12 @@ fn negative_square_root(e: &[f64], k: usize) -> Option<Vec<f64>> {
 }
 
 impl Capacitance {
-    /// Its order R.
+    /// Its order R: the changed blocks' columns (Cholesky) or ranks (LU).
     pub(crate) fn order(&self) -> usize {
-        self.active.len()
+        match &self.factor {
+            CapacitanceFactor::Cholesky { .. } => self.active.len(),
+            CapacitanceFactor::Lu { factors, .. } => factors.iter().map(|f| f.rank).sum(),
+        }
     }
 
     /// The number of load coefficients it goes with (every changed contact's columns).
@@ -243,12 +287,20 @@ impl LowRankCorrection {
         self.columns.len()
     }
 
-    /// The order of the capacitance matrix of `changes` and how many of its columns are new.
+    /// The order of the capacitance matrix of `changes` (the ranks of their blocks) and how
+    /// many of its columns are new.
     pub(crate) fn size_of(&self, changes: &[ContactChange]) -> (usize, usize) {
         changes.iter().fold((0, 0), |(order, new), ch| {
             let have = self.owned[ch.contact].len();
             let need = ch.columns_needed().max(have);
-            let rows = if ch.changes_block() { need } else { 0 };
+            let rows = if ch.changes_block() {
+                let e: Vec<f64> = (0..need * need)
+                    .map(|a| ch.stiffness[(ORDER[a / need], ORDER[a % need])])
+                    .collect();
+                block_rank(&e, need)
+            } else {
+                0
+            };
             (order + rows, new + need - have)
         })
     }
@@ -511,30 +563,65 @@ impl LowRankCorrection {
                 };
             }
         }
-        let r = active.len();
-        let mut data = vec![0.0; r * r];
-        data.par_chunks_mut(r.max(1))
-            .zip(&active)
-            .enumerate()
-            .for_each(|(j, (out, &col))| {
-                let mut offset = 0;
-                for (cols, e) in &blocks {
-                    let k = cols.len();
-                    for i in 0..k {
-                        out[offset + i] =
-                            (0..k).map(|l| e[i * k + l] * self.s[(cols[l], col)]).sum();
-                    }
-                    offset += k;
-                }
-                out[j] += 1.0;
-            });
-        let lu = MatRef::from_column_major_slice(&data, r, r).partial_piv_lu();
+        let factors: Vec<RankFactors> = blocks
+            .iter()
+            .map(|(cols, e)| RankFactors::of(e, cols.len()))
+            .collect();
+        let lu = self.rank_capacitance(&blocks, &active, &factors);
         Capacitance {
             blocks,
             active,
             loaded,
-            factor: CapacitanceFactor::Lu(lu),
+            factor: CapacitanceFactor::Lu { factors, lu },
         }
+    }
+
+    /// The LU factorization of I + Yᵀ S X (X, Y block diagonal with `factors` per block of
+    /// `blocks`), built a column at a time: the column β of block c′ is Yᵀ (S X_c′ e_β) on the
+    /// active rows.
+    fn rank_capacitance(
+        &self,
+        blocks: &[(Vec<usize>, Vec<f64>)],
+        active: &[usize],
+        factors: &[RankFactors],
+    ) -> PartialPivLu<f64> {
+        // (block, its first active row, its first rank row) per column of the matrix.
+        let mut columns = Vec::new();
+        let (mut at, mut rank_at) = (0, 0);
+        let mut starts = Vec::with_capacity(blocks.len());
+        for (b, ((cols, _), f)) in blocks.iter().zip(factors).enumerate() {
+            starts.push((at, rank_at));
+            columns.extend((0..f.rank).map(|beta| (b, beta)));
+            at += cols.len();
+            rank_at += f.rank;
+        }
+        let r = rank_at;
+        let mut data = vec![0.0; r * r];
+        data.par_chunks_mut(r.max(1))
+            .zip(&columns)
+            .enumerate()
+            .for_each(|(j, (out, &(b, beta)))| {
+                let (cols_b, f_b) = (&blocks[b].0, &factors[b]);
+                let mut v = vec![0.0; active.len()];
+                for (m, &col) in cols_b.iter().enumerate() {
+                    let weight = f_b.x[m * f_b.rank + beta];
+                    if weight != 0.0 {
+                        let s_col = self.s.col_as_slice(col);
+                        for (vi, &row) in v.iter_mut().zip(active) {
+                            *vi += weight * s_col[row];
+                        }
+                    }
+                }
+                for (((cols, _), f), &(at, rank_at)) in blocks.iter().zip(factors).zip(&starts) {
+                    for a in 0..f.rank {
+                        out[rank_at + a] = (0..cols.len())
+                            .map(|i| f.y[i * f.rank + a] * v[at + i])
+                            .sum();
+                    }
+                }
+                out[j] += 1.0;
+            });
+        MatRef::from_column_major_slice(&data, r, r).partial_piv_lu()
     }
 
     /// The Cholesky factor of I − Cᵀ S C (C block diagonal, `c` per block of `blocks`), factorized
@@ -905,17 +992,33 @@ impl Capacitance {
     /// z with (I + E S) z = E y.
     fn solve(&self, y: Vec<f64>) -> Result<Vec<f64>, SolverError> {
         let r = self.order();
-        let mut z = Vec::with_capacity(r);
+        let mut z = Vec::with_capacity(self.active.len());
         match &self.factor {
-            CapacitanceFactor::Lu(lu) => {
+            CapacitanceFactor::Lu { factors, lu } => {
+                // E = X Yᵀ: z = X t with (I + Yᵀ S X) t = Yᵀ y.
+                let mut t = Vec::with_capacity(r);
                 let mut offset = 0;
-                for (cols, e) in &self.blocks {
-                    let k = cols.len();
-                    let u = &y[offset..offset + k];
-                    z.extend((0..k).map(|i| (0..k).map(|l| e[i * k + l] * u[l]).sum::<f64>()));
-                    offset += k;
+                for ((cols, _), f) in self.blocks.iter().zip(factors) {
+                    let u = &y[offset..offset + cols.len()];
+                    t.extend((0..f.rank).map(|a| {
+                        (0..cols.len())
+                            .map(|i| f.y[i * f.rank + a] * u[i])
+                            .sum::<f64>()
+                    }));
+                    offset += cols.len();
                 }
-                lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut z, r, 1));
+                let order = t.len();
+                lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut t, order, 1));
+                let mut offset = 0;
+                for ((cols, _), f) in self.blocks.iter().zip(factors) {
+                    let tb = &t[offset..offset + f.rank];
+                    z.extend((0..cols.len()).map(|i| {
+                        (0..f.rank)
+                            .map(|a| f.x[i * f.rank + a] * tb[a])
+                            .sum::<f64>()
+                    }));
+                    offset += f.rank;
+                }
             }
             CapacitanceFactor::Cholesky { c, l } => {
                 // E = −C Cᵀ: z = −C t with (I − Cᵀ S C) t = Cᵀ y.
@@ -1053,7 +1156,9 @@ pub(super) mod tests {
             .solve_from(solver.as_mut(), &cap, &early, &low_rank.active_load(&first))
             .expect("solve");
         let changes = vec![ch(0, 2), ch(1, 6), ch(2, 3)];
-        assert_eq!(low_rank.size_of(&changes), (11, 6));
+        // Orders are ranks: contact 2's 3 × 3 block has rank 2 (in column order its third
+        // row is −1.5 times the first minus the second), so 2 + 6 + 2 rows; 6 new columns.
+        assert_eq!(low_rank.size_of(&changes), (10, 6));
         low_rank
             .extend(solver.as_mut(), &changes, column)
             .expect("extend");
@@ -1109,7 +1214,7 @@ pub(super) mod tests {
             }
         }
         let cap = low_rank.capacitance(&changes);
-        assert!(matches!(cap.factor, CapacitanceFactor::Lu(_)));
+        assert!(matches!(cap.factor, CapacitanceFactor::Lu { .. }));
         let x = low_rank.solve(solver.as_mut(), &cap, &b).expect("solve");
         let expected = dense
             .clone()
@@ -1203,12 +1308,12 @@ pub(super) mod tests {
             "relative error with the Cholesky capacitance: {err}"
         );
         // Contact 1's load changes alone (E = 0): it is no row of the capacitance, whose order
-        // is the other two contacts' 5 columns, and its U Δχ still reaches the solution.
+        // is the other two contacts' ranks 2 + 2, and its U Δχ still reaches the solution.
         let mut mixed = changes.clone();
         mixed[1].stiffness = BlockCoefficients::zeros();
-        assert_eq!(low_rank.size_of(&mixed), (5, 0));
+        assert_eq!(low_rank.size_of(&mixed), (4, 0));
         let cap = low_rank.capacitance(&mixed);
-        assert_eq!((cap.order(), cap.loads()), (5, 11));
+        assert_eq!((cap.order(), cap.loads()), (4, 11));
         let load = low_rank.active_load(&mixed);
         let spread = low_rank.spread(&mixed, &load);
         let b1: Vec<f64> = b.iter().zip(&spread).map(|(p, q)| p + q).collect();
