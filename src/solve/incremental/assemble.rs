@@ -72,8 +72,8 @@ impl StickSlip<'_, '_> {
                 .collect();
             check_supported_with(setup.model, &closed)?;
         }
-        let nonsymmetric = setup.opts.consistent_coulomb_tangent
-            && matches!(setup.friction(), crate::contact::Friction::Coulomb { mu, .. } if mu > 0.0)
+        let nonsymmetric = contacts.consistent_coulomb()
+            && !contacts.symmetric_step
             && contacts.states.contains(&ContactState::Slip);
         inc.lap(|t| &mut t.assemble);
         Ok(System {

@@ -47,8 +47,15 @@ impl StickSlip<'_, '_> {
                 contacts.switched(i, t, pairs[i].penalty_tangent, setup.direction_tol)
                     || (!held
                         && unsettled_force(t, contacts.directions[i], contacts.perpendicular[i]))
-                    // A sliding Coulomb contact's bound moved (the fixed point on the bounds).
-                    || (setup.bound_fixed_point
+                    // A sliding Coulomb contact crossed N = 0, where its bound's slope jumps
+                    // (the consistent tangent).
+                    || (contacts.consistent_coulomb()
+                        && t.state == ContactState::Slip
+                        && !held
+                        && contacts.compressed[i] != (t.normal_force > 0.0))
+                    // A sliding Coulomb contact's bound moved (the fixed point on the bounds, or
+                    // a symmetric step of the consistent tangent).
+                    || ((setup.bound_fixed_point || contacts.symmetric_step)
                         && t.state == ContactState::Slip
                         && !held
                         && (t.bound - contacts.bounds[i]).abs()

@@ -29,6 +29,17 @@ pub(super) struct ContactStates {
     /// contacts slid then (for the bounds' predictor), and the last increment's load factor.
     previous: Option<(f64, Vec<f64>, Vec<bool>)>,
     last_alpha: Option<f64>,
+    /// With the consistent Coulomb tangent: per contact, whether its last trial normal force
+    /// was positive. The bound c + μ max(N, 0) has the slope μ p_N in compression and none in
+    /// tension (a bonded crossing pulled apart slides at its cohesion alone), so a sliding
+    /// contact is linearized as Coulomb in the first case and as Tresca at c in the second.
+    pub compressed: Vec<bool>,
+    /// With the consistent Coulomb tangent: this state iteration assembles sliding Coulomb
+    /// contacts at their last trial bounds (Tresca), symmetric — the fixed-point step taken
+    /// where the nonsymmetric system cannot be solved on the reference factorization (a
+    /// sparse LU of a large cell would need many times its memory). Its bounds are checked
+    /// like the fixed point's.
+    pub symmetric_step: bool,
     friction: Friction,
     bound_fixed_point: bool,
 }
@@ -55,6 +66,8 @@ impl ContactStates {
             acceleration: BoundAcceleration::default(),
             previous: None,
             last_alpha: None,
+            compressed: vec![false; n],
+            symmetric_step: false,
             friction,
             bound_fixed_point: setup.bound_fixed_point,
         }
@@ -76,13 +89,21 @@ impl ContactStates {
     /// The friction law contact i is assembled with: Tresca at its bound in the Coulomb fixed
     /// point, else the run's.
     pub fn friction_of(&self, i: usize) -> Friction {
-        if self.bound_fixed_point {
-            Friction::Tresca {
+        match self.friction {
+            _ if self.bound_fixed_point || self.symmetric_step => Friction::Tresca {
                 bound: self.bounds[i],
+            },
+            Friction::Coulomb { cohesion, .. } if !self.compressed[i] => {
+                Friction::Tresca { bound: cohesion }
             }
-        } else {
-            self.friction
+            friction => friction,
         }
+    }
+
+    /// Whether sliding Coulomb contacts carry the consistent tangent μ p_N d nᵀ (Newton on
+    /// the bounds) rather than the fixed point on the bounds.
+    pub fn consistent_coulomb(&self) -> bool {
+        !self.bound_fixed_point && matches!(self.friction, Friction::Coulomb { mu, .. } if mu > 0.0)
     }
 
     /// What contact i's block is assembled from.
@@ -142,12 +163,14 @@ impl ContactStates {
         for &i in changed {
             // A change of state always counts as a switch, and after SETTLING_ITERATIONS every
             // change does: a contact that does not settle is then held like a chattering one.
-            // Before, with the Coulomb fixed point the slip directions and bounds settle
-            // together, linearly, so their changes do not count; without it a change of slip
-            // direction counts (a sliding force that is off the bound does not).
+            // Before, with Coulomb friction the slip directions and bounds settle together
+            // (linearly on the fixed point, quadratically with the consistent tangent), so
+            // their changes do not count; otherwise a change of slip direction counts (a
+            // sliding force that is off the bound does not).
             let counts = trials[i].state != self.states[i]
                 || iteration > SETTLING_ITERATIONS
                 || (!self.bound_fixed_point
+                    && !self.consistent_coulomb()
                     && self.switched(i, &trials[i], pairs[i].penalty_tangent, direction_tol));
             if counts {
                 self.switches[i] += 1;
@@ -178,7 +201,13 @@ impl ContactStates {
                 self.bounds[i] = b;
             }
         }
+        let consistent = self.consistent_coulomb();
+        self.symmetric_step = false;
         for (i, t) in trials.iter().enumerate() {
+            self.compressed[i] = t.normal_force > 0.0;
+            if consistent && t.state == ContactState::Slip {
+                self.bounds[i] = t.bound;
+            }
             // Newton's next iterate linearizes every sliding contact at this trial: its
             // direction too, however small the change (the spring k⊥ is anchored here).
             if t.state == ContactState::Slip && self.states[i] == ContactState::Slip {

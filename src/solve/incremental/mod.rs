@@ -211,6 +211,7 @@ impl<'a, 'h> StickSlip<'a, 'h> {
         // New α and committed slips: a new reference load.
         self.factors.reference_solution = None;
         self.contacts.switches.fill(0);
+        self.contacts.symmetric_step = false;
         self.contacts.acceleration.restart();
         self.contacts.predict_bounds(alpha);
         let max_iterations = self.setup.opts.max_state_iterations;
@@ -302,6 +303,15 @@ impl<'a, 'h> StickSlip<'a, 'h> {
                 }
             }
             None => {
+                if system.nonsymmetric && self.setup.low_rank_possible {
+                    // Not on the reference: a symmetric fixed-point step instead of a sparse
+                    // LU (see `ContactStates::symmetric_step`), whose factorization becomes
+                    // the reference (the sliding contacts' blocks are then in A₀, and only
+                    // their Coulomb terms and later changes in the correction).
+                    self.contacts.symmetric_step = true;
+                    self.factors.refresh_reference = true;
+                    *system = self.assemble(inc)?;
+                }
                 let (x, report) = self.solve_direct(inc, system)?;
                 Solved {
                     x,

@@ -67,13 +67,18 @@ pub struct IncrementalOptions {
     /// Stop after the increment during which this instant passes (default: none); the solution
     /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
     pub deadline: Option<std::time::Instant>,
-    /// Solve Coulomb sliding with its consistent tangent K_T^sl = μ p_N Bᵀd nᵀB (4.63), a
-    /// nonsymmetric system for faer LU. Default false: each sliding contact's friction force
-    /// is a load at the bound c + μ max(N, 0) of the state iteration's last normal force N,
-    /// iterated until no bound moves by more than [`BOUND_TOLERANCE`] of itself (a fixed point
-    /// on the bounds, as for Tresca friction with the bound updated), so every system stays
-    /// symmetric for Cholesky and the low-rank corrections; at convergence both satisfy the
-    /// same Coulomb law.
+    /// Solve Coulomb sliding with its consistent tangent K_T^sl = μ p_N Bᵀd nᵀB (4.63) for a
+    /// contact in compression (in tension the bound c + μ max(N, 0) has no slope): Newton on
+    /// the bounds, nonsymmetric systems solved as low-rank corrections of the symmetric
+    /// reference factorization (each sliding block relative to stick has rank 2); where the
+    /// reference cannot serve, that state iteration takes a symmetric fixed-point step whose
+    /// factorization becomes the new reference, and only without factor reuse does a system
+    /// go to faer LU. Default false: each sliding contact's friction force is a load at the
+    /// bound c + μ max(N, 0) of the state iteration's last normal force N, iterated until no
+    /// bound moves by more than [`BOUND_TOLERANCE`] of itself (a fixed point on the bounds, as
+    /// for Tresca friction with the bound updated), so every system stays symmetric for
+    /// Cholesky and the low-rank corrections; at convergence both satisfy the same Coulomb
+    /// law (`tests/curve_consistent_tangent.rs`).
     pub consistent_coulomb_tangent: bool,
 }
 
