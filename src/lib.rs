@@ -36,3 +36,30 @@ pub mod stats;
 pub use error::Error;
 pub use fibercell_solver as solver;
 pub use model::Model;
+
+/// The Rust examples of the README and of `docs/`, compiled and run as doctests.
+#[cfg(doctest)]
+mod doc_examples {
+    #[doc = include_str!("../README.md")]
+    struct Readme;
+    #[doc = include_str!("../docs/architecture.md")]
+    struct Architecture;
+    #[doc = include_str!("../docs/cli.md")]
+    struct Cli;
+    #[doc = include_str!("../docs/contact.md")]
+    struct Contact;
+    #[doc = include_str!("../docs/generators.md")]
+    struct Generators;
+    #[doc = include_str!("../docs/homogenization.md")]
+    struct Homogenization;
+    #[doc = include_str!("../docs/library.md")]
+    struct Library;
+    #[doc = include_str!("../docs/model-format.md")]
+    struct ModelFormat;
+    #[doc = include_str!("../docs/performance.md")]
+    struct Performance;
+    #[doc = include_str!("../docs/testing.md")]
+    struct Testing;
+    #[doc = include_str!("../docs/theory.md")]
+    struct Theory;
+}

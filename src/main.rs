@@ -24,8 +24,9 @@ struct Cli {
 /// The linear solver of every command that solves.
 #[derive(clap::Args, Clone, Debug)]
 struct SolverArgs {
-    /// Linear solver backend (cholmod needs a build with `--features cholmod`); systems that
-    /// sliding Coulomb contacts make nonsymmetric go to faer-lu whatever is chosen.
+    /// Linear solver backend (cholmod needs a build with `--features cholmod`); it solves
+    /// every system, as Coulomb sliding is solved on symmetric ones (a fixed point on the
+    /// friction bounds).
     #[arg(long, default_value = "faer-cholesky", value_parser = solver_parser())]
     solver: SolverKind,
     /// Fill-reducing ordering of the Cholesky backends: auto (the better of amd and nd by
@@ -180,7 +181,7 @@ enum Command {
         cell_strain: fibercell::cell::MacroStrain,
     },
     /// Throughput benchmark on generated non-woven cells: every stage timed, against the
-    /// machine's measured DGEMM and memory bandwidth (see the README's performance section).
+    /// machine's measured DGEMM and memory bandwidth (see docs/performance.md).
     Bench {
         /// Presets to run, comma-separated: S, M, L.
         #[arg(long, default_value = "S,M", value_delimiter = ',')]
@@ -207,8 +208,8 @@ enum Command {
         /// Do not run: render the report of an earlier --json file.
         #[arg(long)]
         from_json: Option<PathBuf>,
-        /// Replace the README's performance tables (between the bench:start and bench:end
-        /// markers) with this report.
+        /// Replace the performance tables of this Markdown file (docs/performance.md; between
+        /// its bench:start and bench:end markers) with this report.
         #[arg(long)]
         readme: Option<PathBuf>,
     },
@@ -241,13 +242,13 @@ enum Command {
 
 #[derive(Subcommand)]
 enum GenerateKind {
-    /// A stochastic non-woven: fibers deposited one on another (see the README).
+    /// A stochastic non-woven: fibers deposited one on another (see docs/generators.md).
     Nonwoven {
         /// All parameters from a TOML file (the fields of `generate::NonWoven`); the flags
         /// below override it.
         #[arg(long, conflicts_with = "preset")]
         params: Option<PathBuf>,
-        /// Start from a benchmark cell: S, M or L (see the README).
+        /// Start from a benchmark cell: S, M or L (see docs/generators.md).
         #[arg(long)]
         preset: Option<String>,
         /// Cell periods Lx,Ly (m).
@@ -290,7 +291,7 @@ enum GenerateKind {
         #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
     },
-    /// A plain or twill weave (see the README).
+    /// A plain or twill weave (see docs/generators.md).
     Woven {
         /// All parameters from a TOML file (the fields of `generate::Weave`).
         #[arg(long)]

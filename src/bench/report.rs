@@ -1,5 +1,5 @@
 //! The benchmark report as Markdown tables: printed by `fibercell bench` and pasted into the
-//! README's performance section.
+//! performance page (`docs/performance.md`).
 
 use super::BenchReport;
 use std::fmt::Write;
@@ -286,7 +286,7 @@ pub fn reproduce_command(r: &BenchReport) -> String {
         .map_or(String::new(), |s| format!(" --curve-time-limit {s}"));
     format!(
         "cargo run --release{} -- bench --cells {} --repeats {} --seed {} --curve-steps {steps}\
-         {limit} --json {REPORT_PATH} --readme README.md",
+         {limit} --json {REPORT_PATH} --readme docs/performance.md",
         if cholmod { " --features cholmod" } else { "" },
         cells.join(","),
         r.repeats,
