@@ -20,7 +20,8 @@ pub(crate) use incremental::{run_incremental, OnAllStick};
 pub use incremental::{
     solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
     IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, BOUND_TOLERANCE,
-    MAX_CONTACT_RECORDS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
+    EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS, MAX_HELD_RESIDUAL, MAX_INCREMENTS,
+    MAX_LOW_RANK_COLUMNS,
 };
 pub use job_system::{job_system, JobSystem};
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};

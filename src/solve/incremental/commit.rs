@@ -114,10 +114,12 @@ impl StickSlip<'_, '_> {
             },
         };
         energy.previous = (forces.clone(), q.clone());
-        let applied_free = &setup.applied_free;
-        let load_norm = alpha * applied_free.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let equilibrium_residual = free_norm(disc, &forces, (applied_free, alpha))
-            / (energy.force_scale + load_norm).max(f64::MIN_POSITIVE);
+        let equilibrium_residual = relative_residual(
+            disc,
+            &forces,
+            (&setup.applied_free, alpha),
+            energy.force_scale,
+        );
         let (reaction, reactions) = support_reactions(model, &forces, alpha);
         let macro_reaction = disc
             .driver()
@@ -216,6 +218,45 @@ fn commit_contact(
         record,
         energy,
     }
+}
+
+impl StickSlip<'_, '_> {
+    /// The equilibrium residual the increment to load factor `alpha` would commit with the
+    /// law's forces of `trials` at the current displacements (see [`StickSlip::commit`]).
+    pub(super) fn equilibrium_residual(&self, alpha: f64, trials: &[Trial]) -> f64 {
+        let (setup, q) = (&self.setup, &self.q[..]);
+        let mut forces = setup.elastic.internal(setup.model, q);
+        let norm = forces.iter().map(|f| f * f).sum::<f64>().sqrt();
+        let scale = self.energy.force_scale.max(norm);
+        let contact_forces: Vec<_> = setup
+            .pairs
+            .par_iter()
+            .with_min_len(256)
+            .zip(trials)
+            .zip(&self.contacts.slips)
+            .map(|((pair, t), slip)| commit_contact(pair, t, slip, q, setup.stabilization).forces)
+            .collect();
+        for (pair, f) in setup.pairs.iter().zip(&contact_forces) {
+            for (k, &n) in pair.jump.nodes.iter().enumerate() {
+                for d in 0..6 {
+                    forces[6 * n + d] += f[6 * k + d];
+                }
+            }
+        }
+        relative_residual(setup.disc, &forces, (&setup.applied_free, alpha), scale)
+    }
+}
+
+/// ‖R‖/(`scale` + ‖α F‖): R = f − α F on the free DOFs (see [`free_norm`]), `scale` the
+/// elements' forces.
+fn relative_residual(
+    disc: &Discretization,
+    forces: &[f64],
+    (load, alpha): (&[f64], f64),
+    scale: f64,
+) -> f64 {
+    let load_norm = alpha * load.iter().map(|v| v * v).sum::<f64>().sqrt();
+    free_norm(disc, forces, (load, alpha)) / (scale + load_norm).max(f64::MIN_POSITIVE)
 }
 
 /// ‖f − α F‖₂ over the free DOFs of the generalized force vector `forces` (F given on the

@@ -43,8 +43,8 @@ mod stabilizer;
 
 pub use driver_couplings::DriverCouplings;
 pub use options::{
-    IncrementalOptions, Progress, BOUND_TOLERANCE, MAX_CONTACT_RECORDS, MAX_HELD_RESIDUAL,
-    MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
+    IncrementalOptions, Progress, BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS,
+    MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
 };
 pub use records::{
     ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
@@ -218,7 +218,7 @@ impl<'a, 'h> StickSlip<'a, 'h> {
         for iteration in 1..=max_iterations {
             let mut system = self.assemble(&mut inc)?;
             let solved = self.solve(&mut inc, &mut system, iteration)?;
-            let mut classified = self.classify();
+            let mut classified = self.classify_settled(alpha, iteration);
             let mut report = solved.report;
             if let (true, Some(cap)) = (classified.changed.is_empty(), &solved.unchecked) {
                 inc.lap(|t| &mut t.classify);
@@ -229,7 +229,7 @@ impl<'a, 'h> StickSlip<'a, 'h> {
                 };
                 report = Some(checked);
                 if refined {
-                    classified = self.classify();
+                    classified = self.classify_settled(alpha, iteration);
                 }
             }
             let Classified { trials, changed } = classified;

@@ -87,6 +87,15 @@ pub struct IncrementalOptions {
 /// [`IncrementalOptions::consistent_coulomb_tangent`]).
 pub const BOUND_TOLERANCE: f64 = 1e-8;
 
+/// The equilibrium residual ‖R‖/(‖K q‖ + ‖α F‖) with the law's contact forces at or below
+/// which an increment has converged, from state iteration [`SETTLE_BY_EQUILIBRIUM_AFTER`] on,
+/// although sliding forces are still off the law by more than [`BOUND_TOLERANCE`] of their
+/// bounds (see `classify_settled`).
+pub const EQUILIBRIUM_TOLERANCE: f64 = 1e-8;
+
+/// The state iteration from which an increment may converge by its equilibrium residual.
+pub(super) const SETTLE_BY_EQUILIBRIUM_AFTER: usize = 8;
+
 /// State iterations of an increment after which the bounds of the Coulomb fixed point move by
 /// half the step (see the update in the state iteration).
 pub(super) const BOUND_RELAXATION_AFTER: usize = 10;
