@@ -70,6 +70,23 @@ impl ContactChange {
     fn columns_needed(&self) -> usize {
         columns_needed(&self.stiffness, &self.load)
     }
+
+    /// The rank of the block's change as `RankFactors` keeps it (its needed columns are its
+    /// only nonzero ones, so the 6 × 6 matrix's rank is theirs): singular values only, on
+    /// the stack.
+    fn rank(&self) -> usize {
+        let s = self.stiffness.singular_values();
+        let largest = s.max();
+        s.iter()
+            .filter(|&&v| kept_singular_value(v, largest))
+            .count()
+    }
+}
+
+/// Whether a singular value `v` of a block whose largest is `largest` counts for its rank:
+/// above 10⁻¹³ of the largest.
+fn kept_singular_value(v: f64, largest: f64) -> bool {
+    largest > 0.0 && v > 1e-13 * largest
 }
 
 /// How many leading entries of the column order a change `e` of block coefficients and `f` of
@@ -198,7 +215,7 @@ impl RankFactors {
         };
         let largest = svd.singular_values.iter().fold(0.0f64, |m, &v| m.max(v));
         let kept: Vec<usize> = (0..k)
-            .filter(|&a| largest > 0.0 && svd.singular_values[a] > 1e-13 * largest)
+            .filter(|&a| kept_singular_value(svd.singular_values[a], largest))
             .collect();
         let rank = kept.len();
         let mut x = vec![0.0; k * rank];
@@ -211,11 +228,6 @@ impl RankFactors {
         }
         RankFactors { x, y, rank }
     }
-}
-
-/// The rank of a k × k block E (row-major) as [`RankFactors`] keeps it.
-fn block_rank(e: &[f64], k: usize) -> usize {
-    RankFactors::of(e, k).rank
 }
 
 /// C with C Cᵀ = −E for a symmetric negative semi-definite k × k block `e` (row-major), to
@@ -293,14 +305,7 @@ impl LowRankCorrection {
         changes.iter().fold((0, 0), |(order, new), ch| {
             let have = self.owned[ch.contact].len();
             let need = ch.columns_needed().max(have);
-            let rows = if ch.changes_block() {
-                let e: Vec<f64> = (0..need * need)
-                    .map(|a| ch.stiffness[(ORDER[a / need], ORDER[a % need])])
-                    .collect();
-                block_rank(&e, need)
-            } else {
-                0
-            };
+            let rows = if ch.changes_block() { ch.rank() } else { 0 };
             (order + rows, new + need - have)
         })
     }

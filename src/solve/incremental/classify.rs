@@ -12,6 +12,9 @@ use rayon::prelude::*;
 pub(super) struct Classified {
     pub trials: Vec<Trial>,
     pub changed: Vec<usize>,
+    /// No changed contact moved its state, slip direction or sign of N: they only carry
+    /// sliding forces off the law.
+    pub forces_only: bool,
 }
 
 impl StickSlip<'_, '_> {
@@ -24,18 +27,9 @@ impl StickSlip<'_, '_> {
     /// solves carry).
     pub(super) fn classify_settled(&self, alpha: f64, iteration: usize) -> Classified {
         let mut classified = self.classify();
-        if iteration < SETTLE_BY_EQUILIBRIUM_AFTER || classified.changed.is_empty() {
-            return classified;
-        }
-        let (contacts, pairs) = (&self.contacts, &self.setup.pairs);
-        let force_only = |i: usize| {
-            let t = &classified.trials[i];
-            t.state == contacts.states[i]
-                && !contacts.switched(i, t, pairs[i].penalty_tangent, self.setup.direction_tol)
-                && !(contacts.consistent_coulomb()
-                    && contacts.compressed[i] != (t.normal_force > 0.0))
-        };
-        if classified.changed.iter().all(|&i| force_only(i))
+        if iteration >= SETTLE_BY_EQUILIBRIUM_AFTER
+            && !classified.changed.is_empty()
+            && classified.forces_only
             && self.equilibrium_residual(alpha, &classified.trials) <= EQUILIBRIUM_TOLERANCE
         {
             classified.changed.clear();
@@ -68,28 +62,40 @@ impl StickSlip<'_, '_> {
                 }
             })
             .collect();
+        // Per contact: whether it moved (state, slip direction, sign of N) and whether its
+        // sliding force lags the law (off its direction or k⊥ spring, or a bound that moved).
+        let change = |i: usize| {
+            let t = &trials[i];
+            let held = contacts.held(i);
+            let sliding = t.state == ContactState::Slip && !held;
+            let moved = contacts.switched(i, t, pairs[i].penalty_tangent, setup.direction_tol)
+                // A sliding Coulomb contact crossed N = 0, where its bound's slope jumps (the
+                // consistent tangent).
+                || (contacts.consistent_coulomb()
+                    && sliding
+                    && contacts.compressed[i] != (t.normal_force > 0.0));
+            let lags = (!held
+                && unsettled_force(t, contacts.directions[i], contacts.perpendicular[i]))
+                // A sliding Coulomb contact's bound moved (the fixed point on the bounds, or a
+                // symmetric step of the consistent tangent).
+                || ((setup.bound_fixed_point || contacts.symmetric_step)
+                    && sliding
+                    && (t.bound - contacts.bounds[i]).abs()
+                        > BOUND_TOLERANCE * t.bound.max(contacts.bounds[i]));
+            (moved, lags)
+        };
+        let mut forces_only = true;
         let changed: Vec<usize> = (0..pairs.len())
             .filter(|&i| {
-                let t = &trials[i];
-                let held = contacts.held(i);
-                contacts.switched(i, t, pairs[i].penalty_tangent, setup.direction_tol)
-                    || (!held
-                        && unsettled_force(t, contacts.directions[i], contacts.perpendicular[i]))
-                    // A sliding Coulomb contact crossed N = 0, where its bound's slope jumps
-                    // (the consistent tangent).
-                    || (contacts.consistent_coulomb()
-                        && t.state == ContactState::Slip
-                        && !held
-                        && contacts.compressed[i] != (t.normal_force > 0.0))
-                    // A sliding Coulomb contact's bound moved (the fixed point on the bounds, or
-                    // a symmetric step of the consistent tangent).
-                    || ((setup.bound_fixed_point || contacts.symmetric_step)
-                        && t.state == ContactState::Slip
-                        && !held
-                        && (t.bound - contacts.bounds[i]).abs()
-                            > BOUND_TOLERANCE * t.bound.max(contacts.bounds[i]))
+                let (moved, lags) = change(i);
+                forces_only &= !moved;
+                moved || lags
             })
             .collect();
-        Classified { trials, changed }
+        Classified {
+            trials,
+            changed,
+            forces_only,
+        }
     }
 }

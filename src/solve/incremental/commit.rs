@@ -86,11 +86,7 @@ impl StickSlip<'_, '_> {
             energy.dissipated += c.dissipation;
             stored += c.energy.0;
             stabilization_energy += c.energy.1;
-            for (k, &n) in setup.pairs[i].jump.nodes.iter().enumerate() {
-                for d in 0..6 {
-                    forces[6 * n + d] += c.forces[6 * k + d];
-                }
-            }
+            add_block(&mut forces, &setup.pairs[i].jump.nodes, &c.forces);
             records.push(c.record);
         }
         // W_ext by the trapezoidal rule over this increment.
@@ -237,13 +233,18 @@ impl StickSlip<'_, '_> {
             .map(|((pair, t), slip)| commit_contact(pair, t, slip, q, setup.stabilization).forces)
             .collect();
         for (pair, f) in setup.pairs.iter().zip(&contact_forces) {
-            for (k, &n) in pair.jump.nodes.iter().enumerate() {
-                for d in 0..6 {
-                    forces[6 * n + d] += f[6 * k + d];
-                }
-            }
+            add_block(&mut forces, &pair.jump.nodes, f);
         }
         relative_residual(setup.disc, &forces, (&setup.applied_free, alpha), scale)
+    }
+}
+
+/// Adds a contact's generalized forces `f` on its block's nodes `nodes` to `forces`.
+fn add_block(forces: &mut [f64], nodes: &[usize], f: &crate::contact::BlockVector) {
+    for (k, &n) in nodes.iter().enumerate() {
+        for d in 0..6 {
+            forces[6 * n + d] += f[6 * k + d];
+        }
     }
 }
 

@@ -232,7 +232,9 @@ impl<'a, 'h> StickSlip<'a, 'h> {
                     classified = self.classify_settled(alpha, iteration);
                 }
             }
-            let Classified { trials, changed } = classified;
+            let Classified {
+                trials, changed, ..
+            } = classified;
             if changed.is_empty() {
                 inc.lap(|t| &mut t.classify);
                 self.commit(inc, iteration, &trials, report);
