@@ -213,57 +213,93 @@ impl ElementBlocks {
 
     /// Generalized internal forces K q for the full generalized vector q.
     pub fn internal(&self, model: &Model, q: &[f64]) -> Vec<f64> {
+        self.internal_with_scale(model, q).forces
+    }
+
+    /// Generalized internal forces K q and the forces the elements carry, (Σ_e ‖K_e q_e‖²)^½:
+    /// the scale of an equilibrium residual. Unlike ‖K q‖, which vanishes at an unloaded
+    /// node where the elements' forces balance, it measures what the sums cancel, and unlike
+    /// ‖|K| |q|‖ it is blind to rigid motions (K_e q_e = 0 for a rigid motion of element e).
+    pub fn internal_with_scale(&self, model: &Model, q: &[f64]) -> InternalForces {
         if self.identity {
             return identity_internal(model, &q[..6 * model.nodes.len()]);
         }
-        // Column by column, a node's six rows at a time (contiguous in K and in `out`).
-        let add = |out: &mut [f64], e: usize, k: &DMatrix<f64>| {
+        // K_e q_e into `y`, column by column; then a node's six rows at a time into `out`.
+        let add = |out: &mut [f64], y: &mut Vec<f64>, e: usize, k: &DMatrix<f64>| -> f64 {
             let gnodes = self.gnodes_of(model, e);
+            y.clear();
+            y.resize(k.nrows(), 0.0);
             for (c, column) in k.as_slice().chunks_exact(k.nrows()).enumerate() {
                 let qc = q[6 * gnodes[c / 6] + c % 6];
-                if qc == 0.0 {
-                    continue;
-                }
-                for (&g, rows) in gnodes.iter().zip(column.chunks_exact(6)) {
-                    for (o, v) in out[6 * g..6 * g + 6].iter_mut().zip(rows) {
-                        *o += v * qc;
-                    }
+                if qc != 0.0 {
+                    y.iter_mut().zip(column).for_each(|(o, v)| *o += v * qc);
                 }
             }
+            for (&g, rows) in gnodes.iter().zip(y.chunks_exact(6)) {
+                out[6 * g..6 * g + 6]
+                    .iter_mut()
+                    .zip(rows)
+                    .for_each(|(o, v)| *o += v);
+            }
+            y.iter().map(|v| v * v).sum()
         };
         match self.cached(model) {
             // One slice of the elements per thread, each into its own vector, summed.
             Some(all) => {
                 let chunk = all.len().div_ceil(rayon::current_num_threads()).max(1);
-                let parts: Vec<Vec<f64>> = all
+                let parts: Vec<(Vec<f64>, f64)> = all
                     .par_chunks(chunk)
                     .enumerate()
                     .map(|(p, ks)| {
-                        let mut out = vec![0.0; q.len()];
-                        for (i, k) in ks.iter().enumerate() {
-                            add(&mut out, p * chunk + i, k);
-                        }
-                        out
+                        let (mut out, mut y) = (vec![0.0; q.len()], Vec::new());
+                        let squares = ks
+                            .iter()
+                            .enumerate()
+                            .map(|(i, k)| add(&mut out, &mut y, p * chunk + i, k))
+                            .sum::<f64>();
+                        (out, squares)
                     })
                     .collect();
                 let mut parts = parts.into_iter();
-                let mut out = parts.next().unwrap_or_else(|| vec![0.0; q.len()]);
-                for part in parts {
+                let (mut out, mut squares) =
+                    parts.next().unwrap_or_else(|| (vec![0.0; q.len()], 0.0));
+                for (part, s) in parts {
                     out.iter_mut().zip(&part).for_each(|(o, v)| *o += v);
+                    squares += s;
                 }
-                out
+                InternalForces::new(out, squares)
             }
             None => {
-                let mut out = vec![0.0; q.len()];
-                self.matrices(model).for_each(|(e, k)| add(&mut out, e, &k));
-                out
+                let (mut out, mut y, mut squares) = (vec![0.0; q.len()], Vec::new(), 0.0);
+                self.matrices(model)
+                    .for_each(|(e, k)| squares += add(&mut out, &mut y, e, &k));
+                InternalForces::new(out, squares)
             }
         }
     }
 }
 
+/// Generalized internal forces and the scale of the forces the elements carry
+/// (see [`ElementBlocks::internal_with_scale`]).
+#[derive(Clone, Debug)]
+pub struct InternalForces {
+    /// K q on every generalized DOF.
+    pub forces: Vec<f64>,
+    /// (Σ_e ‖K_e q_e‖²)^½.
+    pub element_norm: f64,
+}
+
+impl InternalForces {
+    fn new(forces: Vec<f64>, squares: f64) -> Self {
+        Self {
+            forces,
+            element_norm: squares.sqrt(),
+        }
+    }
+}
+
 /// K u over all global DOFs of a supported structure, element by element (u: 6 per node).
-fn identity_internal(model: &Model, u: &[f64]) -> Vec<f64> {
+fn identity_internal(model: &Model, u: &[f64]) -> InternalForces {
     let contributions: Vec<(usize, [f64; 12])> = (0..model.elements().len())
         .into_par_iter()
         .map(|e| {
@@ -281,12 +317,14 @@ fn identity_internal(model: &Model, u: &[f64]) -> Vec<f64> {
         })
         .collect();
     let mut out = vec![0.0; u.len()];
+    let mut squares = 0.0;
     for (e, fe) in contributions {
+        squares += fe.iter().map(|v| v * v).sum::<f64>();
         for (a, &nd) in model.elements()[e].nodes.iter().enumerate() {
             for d in 0..6 {
                 out[6 * nd + d] += fe[6 * a + d];
             }
         }
     }
-    out
+    InternalForces::new(out, squares)
 }

@@ -8,7 +8,7 @@ mod pattern;
 mod shared;
 
 pub use coloring::{color_blocks, color_elements};
-pub use element_blocks::ElementBlocks;
+pub use element_blocks::{ElementBlocks, InternalForces};
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
 pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};
 pub(crate) use shared::{prefetch, SharedMut};

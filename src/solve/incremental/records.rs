@@ -98,7 +98,11 @@ pub struct EnergyBalance {
     pub stored: f64,
     /// Energy of the stabilizing springs (0 without stabilization).
     pub stabilization: f64,
-    /// |W_ext − E_el − E_stab − D| / W_ext (0 when no work was done).
+    /// |W_ext − E_el − E_stab − D| / max |W_ext| so far (0 when no work was done): the
+    /// quadrature error of the increments, first order in their size while contacts slide
+    /// (the dissipation F_t·Δs takes each increment's end force, W_ext the trapezoidal rule:
+    /// per sliding contact and increment they differ by ½ ΔF_t·Δs, ½ μ ΔN |Δs| as the bound
+    /// rises), roundoff while all stick.
     pub relative_error: f64,
 }
 
