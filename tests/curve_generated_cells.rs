@@ -37,13 +37,18 @@ fn max_residual(c: &Curve) -> f64 {
 }
 
 /// The default knit (bonded: interlocked loops) under e11, e22 and g12: every contact slides
-/// by 1 %, nothing is held, every increment within 1e-8 (measured 2.2–2.7e-9).
+/// by 1 %, every increment within 1e-8 (measured 2.2–7.2e-9), and nothing is held after the
+/// first increment. In the first all 16 contacts start to slide at once and their slip
+/// directions settle slowly (all 16 change direction for 13 state iterations under e22); that
+/// ends at iteration 18 or, with the sums of the contact blocks in another order, after
+/// iteration 20, when the contacts still turning are held in the directions solved with
+/// (measured 24 iterations, residual 2.3e-9).
 #[test]
 fn the_default_knit_runs_in_equilibrium() {
     let desc = knitted(&Knit::default()).expect("knit");
     for strain in ["e11=0.01", "e22=0.01", "g12=0.01"] {
         let c = curve(&desc, strain).expect("the curve runs");
-        assert!(c.points.iter().all(|p| p.held == 0), "{strain}");
+        assert!(c.points[1..].iter().all(|p| p.held == 0), "{strain}");
         assert!(max_residual(&c) <= 1e-8, "{strain}: {:e}", max_residual(&c));
         assert!(c.points.last().is_some_and(|p| p.slip > 0), "{strain}");
     }

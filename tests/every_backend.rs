@@ -43,6 +43,14 @@ fn tolerance(kind: SolverKind) -> f64 {
     }
 }
 
+/// The curves' resultants: a state iteration may stop once its equilibrium residual is at
+/// most `EQUILIBRIUM_TOLERANCE` (1e-8), so two backends' answers differ by a few times that
+/// where they stop at different iterates (the knit's first increment, its 16 contacts sliding
+/// at once: 1.8e-8 between faer LU and Cholesky), not by their solves' 1e-12.
+fn curve_tolerance(kind: SolverKind) -> f64 {
+    tolerance(kind).max(5.0 * fibercell::solve::EQUILIBRIUM_TOLERANCE)
+}
+
 /// max |a − b| over the rows and columns `range` of ABD, relative to max |a| there.
 fn block_difference(a: &[[f64; 6]; 6], b: &[[f64; 6]; 6], range: std::ops::Range<usize>) -> f64 {
     let (mut diff, mut scale) = (0.0f64, 0.0f64);
@@ -130,7 +138,7 @@ fn curve_agrees_on_woven_and_knitted_cells() {
                 for k in 0..3 {
                     let d = (p.resultant[k] - q.resultant[k]).abs() / scale;
                     assert!(
-                        d <= tolerance(kind),
+                        d <= curve_tolerance(kind),
                         "{path} {kind} step {}: N{k} off by {d:.2e}",
                         p.step
                     );

@@ -2,12 +2,14 @@
 //! slot map (built once), and the value fill (serial or parallel, refilled in place).
 
 mod coloring;
+mod contact_columns;
 mod element_blocks;
 mod fill;
 mod pattern;
 mod shared;
 
 pub use coloring::{color_blocks, color_elements};
+pub use contact_columns::{add_contact_block, ContactColumns};
 pub use element_blocks::{ElementBlocks, InternalForces};
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
 pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};

@@ -6,7 +6,7 @@
 
 use super::law::{BlockVector, ContactPair, ContactState};
 use crate::model::Friction;
-use nalgebra::{SMatrix, Vector2, Vector3, Vector6};
+use nalgebra::{Matrix3, SMatrix, Vector2, Vector3, Vector6};
 
 /// The 6 × 6 coefficients D of a contact block G D Gᵀ, in the order normal, the two tangents,
 /// the three rotation components.
@@ -122,5 +122,73 @@ impl ContactPair {
             }
         }
         phi
+    }
+}
+
+/// A contact block G D Gᵀ written on the displacement jump: Bᵀ S B + ρ RᵀR, S the 3 × 3
+/// stiffness of the jump B q (nonsymmetric for the Coulomb consistent tangent) and ρ that of
+/// the rotation jump R q. The one form in which every contact block is assembled: the cell
+/// problems' closed contacts, the stick/slip system and its changes (see
+/// [`crate::assembly::ContactColumns`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactBlock {
+    /// S.
+    pub jump: Matrix3<f64>,
+    /// ρ.
+    pub rotation: f64,
+}
+
+impl ContactPair {
+    /// The block of coefficients `d` (see [`ContactPair::block_coefficients`]): S = Q D_tt Qᵀ
+    /// with Q = [n t₁ t₂], ρ = D_rr. Every block the solver builds has a rotational part ρ I
+    /// uncoupled from the translational one (checked in debug builds); G D Gᵀ = Bᵀ S B + ρ RᵀR
+    /// then, as G = [Bᵀ Q, Rᵀ].
+    pub fn block_of(&self, d: &BlockCoefficients) -> ContactBlock {
+        debug_assert!(
+            (0..3).all(|a| (0..3).all(|b| {
+                d[(a, 3 + b)] == 0.0
+                    && d[(3 + a, b)] == 0.0
+                    && (a == b || d[(3 + a, 3 + b)] == 0.0)
+                    && d[(3 + a, 3 + a)] == d[(3, 3)]
+            })),
+            "rotational coefficients not ρ I: {d}"
+        );
+        let q = [self.normal, self.tangents[0], self.tangents[1]];
+        let jump = Matrix3::from_fn(|i, j| {
+            let mut s = 0.0;
+            for (a, qa) in q.iter().enumerate() {
+                for (b, qb) in q.iter().enumerate() {
+                    s += d[(a, b)] * qa[i] * qb[j];
+                }
+            }
+            s
+        });
+        ContactBlock {
+            jump,
+            rotation: d[(3, 3)],
+        }
+    }
+
+    /// The block of a closed contact in the cell problems: K_N + K_R, plus K_T^st when `stick`
+    /// (4.53, 4.58).
+    pub fn closed_block(&self, stick: bool) -> ContactBlock {
+        ContactBlock {
+            jump: self.jump_stiffness(stick),
+            rotation: self.penalty_rotation,
+        }
+    }
+
+    /// (Bᵀ S B + ρ RᵀR) x for the block DOFs `x`.
+    pub fn apply_block(&self, block: &ContactBlock, x: &BlockVector) -> BlockVector {
+        let (b, r) = (&self.jump.b, &self.jump.r);
+        b.transpose() * (block.jump * (b * x)) + r.transpose() * ((r * x) * block.rotation)
+    }
+
+    /// The load G φ of coefficients `phi` (see [`ContactPair::load_coefficients`]): Bᵀ Q φ_t
+    /// + Rᵀ φ_r.
+    pub fn load_of(&self, phi: &Vector6<f64>) -> BlockVector {
+        let force = self.normal * phi[0] + self.tangents[0] * phi[1] + self.tangents[1] * phi[2];
+        let moment = Vector3::new(phi[3], phi[4], phi[5]);
+        self.jump.b.transpose() * force + self.jump.r.transpose() * moment
     }
 }

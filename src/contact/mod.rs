@@ -10,7 +10,7 @@ mod search;
 mod set;
 
 pub use crate::model::{ContactSide, Friction};
-pub use coefficients::{BlockCoefficients, BlockState};
+pub use coefficients::{BlockCoefficients, BlockState, ContactBlock};
 pub use geometry::{closest_points, ClosestPoints};
 pub use kinematics::{centerline_interpolation, jump_operator, Jump, JumpMatrix};
 pub use law::{tangent_basis, BlockMatrix, BlockVector, ContactPair, ContactState, PairKinematics};

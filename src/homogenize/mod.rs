@@ -3,7 +3,6 @@
 //! thesis's moduli and the orthotropic constants of §5.1.2, and the out-of-plane pressure problem
 //! Θ with its B^hom (§3.2, 5.2, 5.4).
 
-mod contact_columns;
 mod curve;
 mod elastic;
 mod orthotropic;

@@ -6,8 +6,7 @@
 //! (K_N + K_T^st, plus the rolling resistance K_R): the elastic moduli A^elas of thesis (5.5).
 //! Contacts are searched with the periodic images, so crossings on the boundary count.
 
-use super::contact_columns::ContactColumns;
-use crate::assembly::{color_blocks, ElementBlocks, Pattern, SharedMut, NO_SLOT};
+use crate::assembly::{color_blocks, ContactColumns, ElementBlocks, Pattern, SharedMut, NO_SLOT};
 use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain, Periodicity};
 use crate::constraints::Discretization;
 use crate::contact::{ContactPair, ContactSet, ContactSide};
@@ -133,11 +132,11 @@ pub struct PeriodicSystem {
     pub pattern: Pattern,
     /// Every element's block on the generalized nodes.
     elements: ElementBlocks,
-    pub(super) contacts: Vec<ContactPair>,
+    pub(crate) contacts: Vec<ContactPair>,
     /// Elements by color: no two of a color share a generalized node other than the driver.
     element_colors: Vec<Vec<usize>>,
     /// Closed contacts by the nodes whose columns they fill.
-    pub(super) contact_columns: ContactColumns,
+    pub(crate) contact_columns: ContactColumns,
     /// The node whose translations are fixed.
     pub anchor: usize,
     /// How long building it took.
@@ -344,8 +343,8 @@ impl PeriodicSystem {
             &self.pattern,
             &self.discretization,
             &mut out.values,
-            &mut out.couplings.coupling,
-            |i| self.contacts[i].jump_stiffness(which(i) == ContactStiffness::Stick),
+            Some(&mut out.couplings.coupling),
+            |i| self.contacts[i].closed_block(which(i) == ContactStiffness::Stick),
         );
     }
 

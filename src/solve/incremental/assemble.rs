@@ -6,10 +6,9 @@
 use super::contact_states::ContactStates;
 use super::increment::Increment;
 use super::setup::Setup;
-use super::stabilizer::stabilizer;
 use super::StickSlip;
-use crate::assembly::{SharedMut, NO_SLOT};
-use crate::contact::{BlockMatrix, BlockState, BlockVector, ContactState};
+use crate::assembly::SharedMut;
+use crate::contact::{BlockState, BlockVector, ContactBlock, ContactState};
 use crate::solve::check_supported_with;
 use crate::solve::kept_contact_loads::KeptContactLoads;
 use crate::solve::low_rank::ContactChange;
@@ -57,11 +56,15 @@ impl StickSlip<'_, '_> {
         };
         if changes.is_none() {
             // The contact blocks and loads for the current states.
-            scatter.by_colors(
-                &|i| Some(contacts.states[i]),
-                &mut rhs,
-                Some(&mut matrix.values),
+            setup.contact_columns.add(
+                &setup.pairs,
+                &setup.pattern,
+                setup.disc,
+                &mut matrix.values,
+                None,
+                |i| contact_block(setup, contacts, i),
             );
+            scatter.by_colors(&|i| Some(contacts.states[i]), &mut rhs);
         } else {
             scatter.loads(inc, kept_loads, &mut rhs);
         }
@@ -85,6 +88,16 @@ impl StickSlip<'_, '_> {
             nonsymmetric,
         })
     }
+}
+
+/// Contact i's block in its current state (see [`ContactPair::block_coefficients`]).
+pub(super) fn contact_block(setup: &Setup<'_>, contacts: &ContactStates, i: usize) -> ContactBlock {
+    let pair = &setup.pairs[i];
+    pair.block_of(&pair.block_coefficients(
+        &contacts.block(i),
+        contacts.friction_of(i),
+        setup.stabilization,
+    ))
 }
 
 /// The contacts whose block coefficients or load differ from the reference's.
@@ -129,106 +142,45 @@ struct Scatter<'s, 'a> {
 }
 
 impl Scatter<'_, '_> {
-    /// K_N + K_T^sl (+ the consistent tangent k⊥ across the slip direction) + K_R (+ ε K_T^st)
-    /// and its load, of sliding contact i.
-    fn sliding_block(&self, i: usize) -> (BlockMatrix, BlockVector) {
-        let (pair, c) = (&self.setup.pairs[i], self.contacts);
-        // K_N + K_R and F_N: the closed contact's springs without the tangential one.
-        let m = pair.size();
-        let closed = pair.closed_stiffness(false);
-        let mut k = BlockMatrix::from_fn(|r, s| if r < m && s < m { closed(r, s) } else { 0.0 });
-        let mut f = pair.stick_load(&Vector2::zeros());
-        let (ks, fs) = pair.slip(c.friction_of(i), &c.directions[i]);
-        k += ks;
-        f += fs;
-        if c.perpendicular[i].0 > 0.0 {
-            let (kp, fp) = pair.slip_perpendicular(
-                &c.directions[i],
-                c.perpendicular[i].0,
-                &c.perpendicular[i].1,
-            );
-            k += kp;
-            f += fp;
-        }
-        if self.setup.stabilization > 0.0 {
-            k += stabilizer(pair, ContactState::Slip) * self.setup.stabilization;
-        }
-        (k, f)
-    }
-
-    /// Contact i's load in `state`, times `sign`, into `rhs`, and with `values` its block into
-    /// the matrix: the caller keeps concurrent calls on distinct nodes.
-    fn contact_into(
-        &self,
-        i: usize,
-        state: ContactState,
-        sign: f64,
-        rhs: &SharedMut<f64>,
-        values: Option<&SharedMut<f64>>,
-    ) {
-        let (setup, alpha) = (self.setup, self.alpha);
+    /// Contact i's load in `state` (G φ, see [`ContactPair::load_coefficients`]) minus its
+    /// block's products with the prescribed DOFs at α, times `sign`, into `rhs`: the caller
+    /// keeps concurrent calls on distinct nodes.
+    fn contact_into(&self, i: usize, state: ContactState, sign: f64, rhs: &SharedMut<f64>) {
+        let (setup, contacts, alpha) = (self.setup, self.contacts, self.alpha);
         let disc = setup.disc;
         let pair = &setup.pairs[i];
-        let m = pair.size();
-        let slots = setup.pattern.extra_slots(i);
-        let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
-        let scatter = |k: &dyn Fn(usize, usize) -> f64, f: &BlockVector| {
-            for r in 0..m {
-                let Some(ir) = disc.reduced(gdof(r)) else {
-                    continue;
-                };
-                // SAFETY: row r is a free DOF of a node no concurrent call holds, and so are
-                // the slots of row r.
-                let rhs_r = unsafe { rhs.get(ir) };
-                *rhs_r += sign * f[r];
-                if let Some(values) = values {
-                    for c in 0..m {
-                        let s = slots[r * m + c];
-                        if s != NO_SLOT {
-                            // SAFETY: as above.
-                            unsafe { *values.get(s as usize) += k(r, c) };
-                        }
-                    }
-                }
-                for &c in &setup.prescribed[i] {
-                    *rhs_r -= sign * k(r, c) * alpha * disc.prescribed_value(gdof(c));
-                }
-            }
+        let block_state = BlockState {
+            state,
+            ..contacts.block(i)
         };
-        let stabilization = setup.stabilization;
-        match state {
-            // Stuck contacts, the most, entry by entry: K_N + K_T^st + K_R.
-            ContactState::Stick => scatter(
-                &pair.closed_stiffness(true),
-                &pair.stick_load(&self.contacts.slips[i]),
-            ),
-            // ε (K_N + K_T^st + K_R), the open contact's stabilizer.
-            ContactState::Open if stabilization > 0.0 => {
-                let k = pair.closed_stiffness(true);
-                scatter(&|r, c| stabilization * k(r, c), &BlockVector::zeros())
-            }
-            ContactState::Open => {}
-            ContactState::Slip => {
-                let (k, f) = self.sliding_block(i);
-                scatter(&|r, c| k[(r, c)], &f)
+        let friction = contacts.friction_of(i);
+        let (anchor, slip) = (&contacts.perpendicular[i].1, &contacts.slips[i]);
+        let mut f = pair.load_of(&pair.load_coefficients(&block_state, anchor, slip, friction));
+        let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
+        let mut prescribed = BlockVector::zeros();
+        for &c in &setup.prescribed[i] {
+            prescribed[c] = alpha * disc.prescribed_value(gdof(c));
+        }
+        if prescribed.iter().any(|v| *v != 0.0) {
+            let d = pair.block_coefficients(&block_state, friction, setup.stabilization);
+            f -= pair.apply_block(&pair.block_of(&d), &prescribed);
+        }
+        for r in 0..pair.size() {
+            if let Some(ir) = disc.reduced(gdof(r)) {
+                // SAFETY: row r is a free DOF of a node no concurrent call holds.
+                unsafe { *rhs.get(ir) += sign * f[r] };
             }
         }
     }
 
     /// Every contact in the state `state` gives it (None: left out), color by color in
     /// parallel (sums independent of the number of threads).
-    fn by_colors(
-        &self,
-        state: &(dyn Fn(usize) -> Option<ContactState> + Sync),
-        rhs: &mut [f64],
-        values: Option<&mut [f64]>,
-    ) {
+    fn by_colors(&self, state: &(dyn Fn(usize) -> Option<ContactState> + Sync), rhs: &mut [f64]) {
         let shared_rhs = SharedMut::new(rhs);
-        let shared_values = values.map(SharedMut::new);
         for color in &self.setup.contact_colors {
             color.par_iter().with_min_len(16).for_each(|&i| {
                 if let Some(state) = state(i) {
-                    self.contact_into(i, state, 1.0, &shared_rhs, shared_values.as_ref())
+                    self.contact_into(i, state, 1.0, &shared_rhs)
                 }
             });
         }
@@ -246,8 +198,8 @@ impl Scatter<'_, '_> {
         let shared_rhs = SharedMut::new(rhs);
         for i in (0..pairs.len()).filter(|&i| contacts.states[i] != base_states[i]) {
             if !setup.prescribed[i].is_empty() {
-                self.contact_into(i, base_states[i], -1.0, &shared_rhs, None);
-                self.contact_into(i, contacts.states[i], 1.0, &shared_rhs, None);
+                self.contact_into(i, base_states[i], -1.0, &shared_rhs);
+                self.contact_into(i, contacts.states[i], 1.0, &shared_rhs);
                 continue;
             }
             let base_state = BlockState {
@@ -294,7 +246,7 @@ impl Scatter<'_, '_> {
         let free = |i: usize| setup.prescribed[i].is_empty();
         let kept = kept.get_or_insert_with(|| {
             let mut sum = vec![0.0; rhs.len()];
-            self.by_colors(&|i| free(i).then_some(states[i]), &mut sum, None);
+            self.by_colors(&|i| free(i).then_some(states[i]), &mut sum);
             KeptContactLoads::new(&states, &contacts.slips, sum)
         });
         kept.update(
@@ -313,7 +265,7 @@ impl Scatter<'_, '_> {
         );
         let mut base: Vec<f64> = rhs.iter().zip(kept.sum()).map(|(r, k)| r + k).collect();
         // The contacts on prescribed DOFs, whose loads follow α.
-        self.by_colors(&|i| (!free(i)).then_some(states[i]), &mut base, None);
+        self.by_colors(&|i| (!free(i)).then_some(states[i]), &mut base);
         (states, base)
     }
 }

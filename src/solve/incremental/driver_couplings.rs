@@ -2,6 +2,7 @@
 //! from the stick/slip run's own blocks: with a factorization of K_ff they give the elastic
 //! ABD = (K_EE − K_Ef K_ff⁻¹ K_fE) / area of the cell problems (thesis 5.5).
 
+use super::assemble::contact_block;
 use super::contact_states::ContactStates;
 use super::setup::Setup;
 use crate::contact::ContactState;
@@ -53,20 +54,12 @@ impl DriverCouplings {
                 add(gnodes, &|r, c| k[(r, c)]);
             }
         }
-        let stabilization = setup.stabilization;
-        for (pair, state) in setup.pairs.iter().zip(&contacts.states) {
-            if !pair.jump.nodes.contains(&driver) {
-                continue;
-            }
-            let k = pair.closed_stiffness(true);
-            match state {
-                ContactState::Stick => add(&pair.jump.nodes, &k),
-                ContactState::Open if stabilization > 0.0 => {
-                    add(&pair.jump.nodes, &|r, c| stabilization * k(r, c))
-                }
-                _ => {}
-            }
-        }
+        out.k_ee +=
+            setup
+                .contact_columns
+                .add_driver_columns(&setup.pairs, disc, &mut out.coupling, |i| {
+                    contact_block(setup, contacts, i)
+                });
         Some(out)
     }
 }

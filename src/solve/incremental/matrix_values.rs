@@ -2,8 +2,8 @@
 //! the blocks of the contacts changed since.
 
 use super::super::ContactChange;
-use crate::assembly::{Pattern, NO_SLOT};
-use crate::contact::{BlockCoefficients, ContactPair};
+use crate::assembly::{add_contact_block, Pattern, NO_SLOT};
+use crate::contact::ContactPair;
 
 /// The matrix values of the current state iteration and of the reference factorization A₀.
 pub(super) struct MatrixValues {
@@ -54,27 +54,9 @@ impl MatrixValues {
         }
         self.changed_since_reference = Some(changes.iter().map(|ch| ch.contact).collect());
         for ch in changes {
-            add_block_change(
-                &pairs[ch.contact],
-                pattern.extra_slots(ch.contact),
-                &ch.stiffness,
-                &mut self.values,
-            );
-        }
-    }
-}
-
-/// Adds G ΔD Gᵀ, the change `e` of `pair`'s block coefficients, to its slots in `values`.
-fn add_block_change(pair: &ContactPair, slots: &[u32], e: &BlockCoefficients, values: &mut [f64]) {
-    let g = pair.jump_basis();
-    let m = pair.size();
-    for r in 0..m {
-        let ge: [f64; 6] = std::array::from_fn(|b| (0..6).map(|a| g[a][r] * e[(a, b)]).sum());
-        for c in 0..m {
-            let s = slots[r * m + c];
-            if s != NO_SLOT {
-                values[s as usize] += (0..6).map(|b| ge[b] * g[b][c]).sum::<f64>();
-            }
+            let pair = &pairs[ch.contact];
+            let slots = pattern.extra_slots(ch.contact);
+            add_contact_block(pair, &pair.block_of(&ch.stiffness), slots, &mut self.values);
         }
     }
 }

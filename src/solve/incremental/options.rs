@@ -87,8 +87,9 @@ pub struct IncrementalOptions {
 /// [`IncrementalOptions::consistent_coulomb_tangent`]).
 pub const BOUND_TOLERANCE: f64 = 1e-8;
 
-/// The equilibrium residual ‖R‖/(‖K q‖ + ‖α F‖) with the law's contact forces at or below
-/// which an increment has converged, from state iteration `SETTLE_BY_EQUILIBRIUM_AFTER` on,
+/// The equilibrium residual ‖R‖/(‖K q‖ + ‖α F‖) with the law's contact forces, K q the
+/// elements' nodal forces (stricter than the reported residual's scale), at or below which an
+/// increment has converged, from state iteration `SETTLE_BY_EQUILIBRIUM_AFTER` on,
 /// although sliding forces are still off the law by more than [`BOUND_TOLERANCE`] of their
 /// bounds (see `classify_settled`).
 pub const EQUILIBRIUM_TOLERANCE: f64 = 1e-8;

@@ -54,13 +54,12 @@ pub struct IncrementRecord {
     pub low_rank: LowRankSizes,
     /// Backward error of the last solve.
     pub backward_error: f64,
-    /// Equilibrium residual ‖R‖₂ / (‖K q‖₂ + ‖α F‖₂) at the converged state, R on the free
-    /// DOFs: R = α F − K q − f_c(q), the contact forces f_c those of the contact law itself
-    /// (the return mapping's normal force, stick force or bound c + μ max(N, 0) along the slip
-    /// direction, not the linearization the last system was assembled with), K q the
-    /// elements' forces, whose norm is taken over every generalized DOF (with the drivers' and
-    /// the supports') and is the largest of the run so far (on an unloading path, the peak
-    /// load's). About the solves' accuracy and the bounds' fixed-point tolerance; with
+    /// Equilibrium residual ‖R‖₂ / (s + ‖α F‖₂) at the converged state, R on the free DOFs:
+    /// R = α F − K q − f_c(q), the contact forces f_c those of the contact law itself (the
+    /// return mapping's normal force, stick force or bound c + μ max(N, 0) along the slip
+    /// direction, not the linearization the last system was assembled with), s = (Σ_e ‖K_e
+    /// q_e‖²)^½ the forces the elements carry, the largest of the run so far (on an unloading
+    /// path, the peak load's). About the solves' accuracy and the bounds' fixed-point tolerance; with
     /// held contacts, how far their state is from equilibrium (an error above
     /// [`MAX_HELD_RESIDUAL`](crate::solve::MAX_HELD_RESIDUAL)).
     pub equilibrium_residual: f64,

@@ -5,8 +5,7 @@
 use super::options::SLIP_DIRECTION_TOLERANCE;
 use super::return_mapping::Law;
 use super::IncrementalOptions;
-use crate::assembly::ElementBlocks;
-use crate::assembly::{color_blocks, Pattern};
+use crate::assembly::{color_blocks, ContactColumns, ElementBlocks, Pattern};
 use crate::constraints::Discretization;
 use crate::contact::{ContactPair, ContactSet, Friction};
 use crate::model::Model;
@@ -37,8 +36,10 @@ pub(super) struct Setup<'a> {
     /// K of the elements in the pattern's slots.
     pub k_elastic: Vec<f64>,
     /// Contacts by color: no two of a color share a generalized node (the driver, which has no
-    /// rows, aside), so a color's contacts are scattered in parallel.
+    /// rows, aside), so a color's contacts add their loads in parallel.
     pub contact_colors: Vec<Vec<usize>>,
+    /// The contacts by the nodes whose matrix columns they fill.
+    pub contact_columns: ContactColumns,
     /// The elastic load at α = 1: F and the elements' products with prescribed DOFs.
     pub rhs_full: Vec<f64>,
     /// The nodal loads F on the free DOFs (α = 1).
@@ -104,6 +105,7 @@ impl<'a> Setup<'a> {
             pairs.iter().map(|p| &p.jump.nodes[..]),
             disc.driver(),
         );
+        let contact_columns = ContactColumns::new(disc.n_gnodes(), disc.driver(), &pairs, &pattern);
         let mut applied_full = [0.0; 6];
         for l in &model.loads {
             applied_full[l.dof.index()] += l.value;
@@ -136,6 +138,7 @@ impl<'a> Setup<'a> {
             pattern,
             k_elastic,
             contact_colors,
+            contact_columns,
             applied_full,
             prescribed,
             solver_config,

@@ -1,15 +1,17 @@
-//! Node-owned value fill of the closed contacts of a periodic cell: the task of a generalized
-//! node adds, for every contact the node belongs to, the contact's six columns of that node. A
-//! task writes only its own node's columns of K_ff and its own rows of K_fE, so no coloring is
-//! needed, the writes sweep the value array column by column instead of jumping between the
-//! column blocks of a contact, and every entry's sum runs in contact order whatever the number
-//! of threads. The six columns are computed as one small product, Bᵀ (S B_a) + Rᵀ (p_R R_a),
-//! whose rows the compiler vectorizes.
+//! The one value fill of contact blocks, Bᵀ S B + ρ RᵀR (see [`ContactBlock`]): the cell
+//! problems' closed contacts, the stick/slip system in any states and its changes since the
+//! reference factorization. Node-owned: the task of a generalized node adds, for every contact
+//! the node belongs to, the contact's six columns of that node. A task writes only its own
+//! node's columns of K_ff and its own rows of K_fE, so no coloring is needed, the writes sweep
+//! the value array column by column instead of jumping between the column blocks of a contact,
+//! and every entry's sum runs in contact order whatever the number of threads. The six columns
+//! are computed as one small product, Bᵀ (S B_a) + Rᵀ (ρ R_a), whose rows the compiler
+//! vectorizes.
 
 use crate::assembly::{prefetch, Pattern, SharedMut, NO_SLOT};
 use crate::constraints::Discretization;
-use crate::contact::ContactPair;
-use nalgebra::{Matrix3, SMatrix};
+use crate::contact::{ContactBlock, ContactPair};
+use nalgebra::SMatrix;
 use rayon::prelude::*;
 
 /// Most generalized nodes of a contact block (four nodes of two elements and the driver).
@@ -26,9 +28,9 @@ struct Incidence {
     runs: [[u32; MAX_NODES]; 6],
 }
 
-/// The closed contacts listed by the generalized nodes whose columns they write.
+/// The contacts listed by the generalized nodes whose columns they write.
 #[derive(Clone, Debug)]
-pub(crate) struct ContactColumns {
+pub struct ContactColumns {
     /// Incidences of node g: `incidences[node_ptr[g]..node_ptr[g + 1]]`, by contact; the
     /// driver node has none.
     node_ptr: Vec<usize>,
@@ -40,7 +42,7 @@ pub(crate) struct ContactColumns {
 impl ContactColumns {
     /// The incidences of `contacts` on the `n_gnodes` generalized nodes but the `driver`;
     /// contact i's block entries are at `pattern.extra_slots(i)`.
-    pub(crate) fn new(
+    pub fn new(
         n_gnodes: usize,
         driver: Option<usize>,
         contacts: &[ContactPair],
@@ -100,21 +102,21 @@ impl ContactColumns {
         }
     }
 
-    /// Adds the blocks of `contacts` (the ones of [`ContactColumns::new`]), contact i with S =
-    /// `jump_stiffness(i)` (see [`ContactPair::jump_stiffness`]): K_ff to `values`, K_fE to
-    /// `coupling` (row by free DOF), nodes in parallel; returns the K_EE part, summed in contact
-    /// order.
-    pub(crate) fn add(
+    /// Adds the blocks of `contacts` (the ones of [`ContactColumns::new`]), contact i's
+    /// `block(i)`: K_ff to `values`, K_fE to `coupling` (row by free DOF; by symmetry, from
+    /// the driver's rows: symmetric blocks only), nodes in parallel; returns the K_EE part,
+    /// summed in contact order.
+    pub fn add(
         &self,
         contacts: &[ContactPair],
         pattern: &Pattern,
         disc: &Discretization,
         values: &mut [f64],
-        coupling: &mut [[f64; 6]],
-        jump_stiffness: impl Fn(usize) -> Matrix3<f64> + Sync,
+        coupling: Option<&mut [[f64; 6]]>,
+        block: impl Fn(usize) -> ContactBlock + Sync,
     ) -> SMatrix<f64, 6, 6> {
         let values = SharedMut::new(values);
-        let coupling = SharedMut::new(coupling);
+        let coupling = coupling.map(SharedMut::new);
         let n_gnodes = self.node_ptr.len() - 1;
         (0..n_gnodes)
             .into_par_iter()
@@ -130,7 +132,6 @@ impl ContactColumns {
                         }
                         let pair = &contacts[next.contact as usize];
                         prefetch(&pair.normal);
-                        prefetch(&pair.penalty_rotation);
                         for j in (0..3 * pair.size()).step_by(8) {
                             prefetch(&pair.jump.b.as_slice()[j]);
                             prefetch(&pair.jump.r.as_slice()[j]);
@@ -138,7 +139,7 @@ impl ContactColumns {
                     }
                     let i = inc.contact as usize;
                     let pair = &contacts[i];
-                    let s = jump_stiffness(i);
+                    let s = block(i);
                     let position = inc.position as usize;
                     with_node_columns(pair, &s, position, |d, column| {
                         let Some(free) = disc.reduced(6 * g + d) else {
@@ -156,10 +157,13 @@ impl ContactColumns {
                                 }
                             } else if disc.driver() == Some(pair.jump.nodes[b]) {
                                 // Driver rows of column c: by symmetry K_fE's row c.
-                                // SAFETY: row `free` is node g's, which only this task writes.
-                                let row = unsafe { coupling.get(free) };
-                                for (v, k) in row.iter_mut().zip(rows) {
-                                    *v += k;
+                                if let Some(coupling) = &coupling {
+                                    // SAFETY: row `free` is node g's, which only this task
+                                    // writes.
+                                    let row = unsafe { coupling.get(free) };
+                                    for (v, k) in row.iter_mut().zip(rows) {
+                                        *v += k;
+                                    }
                                 }
                             } else {
                                 let m = column.len();
@@ -178,7 +182,7 @@ impl ContactColumns {
             });
         let mut k_ee = SMatrix::<f64, 6, 6>::zeros();
         for &(i, p) in &self.with_driver {
-            let s = jump_stiffness(i);
+            let s = block(i);
             with_node_columns(&contacts[i], &s, p, |d, column| {
                 for e in 0..6 {
                     k_ee[(e, d)] += column[6 * p + e];
@@ -189,21 +193,73 @@ impl ContactColumns {
     }
 }
 
-/// Calls `column(d, k)` with the six columns k = Bᵀ S b_c + p_R Rᵀ r_c, c = 6 `position` + d,
-/// of a closed contact's block (the entries of [`ContactPair::closed_stiffness`]), for the
-/// block's size.
+impl ContactColumns {
+    /// Adds the driver's columns of the blocks of `contacts` that hold it, contact i's
+    /// `block(i)`: K_fE (rows of free DOFs) to `coupling`, and returns K_EE (no symmetry
+    /// assumed).
+    pub fn add_driver_columns(
+        &self,
+        contacts: &[ContactPair],
+        disc: &Discretization,
+        coupling: &mut [[f64; 6]],
+        block: impl Fn(usize) -> ContactBlock,
+    ) -> SMatrix<f64, 6, 6> {
+        let mut k_ee = SMatrix::<f64, 6, 6>::zeros();
+        for &(i, p) in &self.with_driver {
+            let pair = &contacts[i];
+            with_node_columns(pair, &block(i), p, |e, column| {
+                for (r, k) in column.iter().enumerate() {
+                    let g = pair.jump.nodes[r / 6];
+                    if Some(g) == disc.driver() {
+                        k_ee[(r % 6, e)] += k;
+                    } else if let Some(f) = disc.reduced(6 * g + r % 6) {
+                        coupling[f][e] += k;
+                    }
+                }
+            });
+        }
+        k_ee
+    }
+}
+
+/// Adds `block` of contact `pair` to `values` through its row-major slots `slots` (entries
+/// without a slot, on prescribed DOFs, left out): one contact's share of
+/// [`ContactColumns::add`], the same entries (for the few blocks that change between state
+/// iterations).
+pub fn add_contact_block(
+    pair: &ContactPair,
+    block: &ContactBlock,
+    slots: &[u32],
+    values: &mut [f64],
+) {
+    let m = pair.size();
+    for a in 0..pair.jump.nodes.len() {
+        with_node_columns(pair, block, a, |d, column| {
+            let c = 6 * a + d;
+            for (r, k) in column.iter().enumerate() {
+                let slot = slots[r * m + c];
+                if slot != NO_SLOT {
+                    values[slot as usize] += k;
+                }
+            }
+        });
+    }
+}
+
+/// Calls `column(d, k)` with the six columns k = Bᵀ S b_c + ρ Rᵀ r_c, c = 6 `position` + d, of
+/// a contact's block (S, ρ of `block`), for the block's size.
 fn with_node_columns(
     pair: &ContactPair,
-    s: &Matrix3<f64>,
+    block: &ContactBlock,
     position: usize,
     column: impl FnMut(usize, &[f64]),
 ) {
     match pair.jump.nodes.len() {
-        1 => node_columns::<6>(pair, s, position, column),
-        2 => node_columns::<12>(pair, s, position, column),
-        3 => node_columns::<18>(pair, s, position, column),
-        4 => node_columns::<24>(pair, s, position, column),
-        _ => node_columns::<30>(pair, s, position, column),
+        1 => node_columns::<6>(pair, block, position, column),
+        2 => node_columns::<12>(pair, block, position, column),
+        3 => node_columns::<18>(pair, block, position, column),
+        4 => node_columns::<24>(pair, block, position, column),
+        _ => node_columns::<30>(pair, block, position, column),
     }
 }
 
@@ -212,13 +268,13 @@ fn with_node_columns(
 #[inline(always)]
 fn node_columns<const M: usize>(
     pair: &ContactPair,
-    s: &Matrix3<f64>,
+    block: &ContactBlock,
     position: usize,
     mut column: impl FnMut(usize, &[f64]),
 ) {
     let (b, r) = (pair.jump.b.as_slice(), pair.jump.r.as_slice());
     let (b_a, r_a) = (&b[18 * position..], &r[18 * position..]);
-    let p_r = pair.penalty_rotation;
+    let (s, p_r) = (&block.jump, block.rotation);
     // Column d: (S b_c, p_R r_c), c = 6 position + d.
     let sr: [[f64; 6]; 6] = std::array::from_fn(|d| {
         let (bc, rc) = (&b_a[3 * d..3 * d + 3], &r_a[3 * d..3 * d + 3]);
