@@ -5,13 +5,17 @@
 //! with 4 of 38,206 contacts changing).
 //!
 //! nonwoven_small's default curve (Coulomb μ = 0.3, bonded) to ε11 = 1 % in 5 increments takes
-//! 8–11 state iterations per increment; capped at 8, the increments that need more hold the
-//! contacts still changing, and the curve is the uncapped one's to 1e-6.
+//! 8–11 state iterations per increment; capped at 8 without cutback, the increments that need
+//! more hold the contacts still changing, and the curve is the uncapped one's to 1e-6. With
+//! cutback (the default) such an increment is redone as halves instead, each within the cap,
+//! and ends in equilibrium without holding.
 
 use fibercell::homogenize::{elasto_plastic_curve, Curve, CurveOptions};
-use fibercell::solve::{IncrementalOptions, MAX_HELD_RESIDUAL};
+use fibercell::solve::{
+    IncrementalOptions, EQUILIBRIUM_TOLERANCE, MAX_CUTBACKS, MAX_HELD_RESIDUAL,
+};
 
-fn curve(max_state_iterations: usize) -> Curve {
+fn curve(max_state_iterations: usize, max_cutbacks: usize) -> Curve {
     let model =
         fibercell::io::load_model(std::path::Path::new("fixtures/cells/nonwoven_small.toml"))
             .expect("fixture");
@@ -23,6 +27,7 @@ fn curve(max_state_iterations: usize) -> Curve {
             unload: false,
             incremental: IncrementalOptions {
                 max_state_iterations,
+                max_cutbacks,
                 ..IncrementalOptions::default()
             },
         },
@@ -32,13 +37,13 @@ fn curve(max_state_iterations: usize) -> Curve {
 
 #[test]
 fn contacts_still_changing_at_the_last_iteration_are_held() {
-    let free = curve(50);
+    let free = curve(50, 0);
     assert!(free.points.iter().all(|p| p.held == 0));
     assert!(
         free.points.iter().any(|p| p.iterations > 8),
         "the cap below must bind"
     );
-    let capped = curve(8);
+    let capped = curve(8, 0);
     assert_eq!(capped.points.len(), 5);
     for (p, q) in capped.points.iter().zip(&free.points) {
         assert!(p.iterations <= 8);
@@ -54,5 +59,16 @@ fn contacts_still_changing_at_the_last_iteration_are_held() {
                 p.step
             );
         }
+    }
+}
+
+#[test]
+fn with_cutback_a_capped_increment_is_halved_instead() {
+    let capped = curve(8, MAX_CUTBACKS);
+    assert_eq!(capped.points.len(), 5);
+    assert!(capped.points.iter().any(|p| p.cutbacks > 0));
+    for p in &capped.points {
+        assert_eq!(p.held, 0, "increment {}", p.step);
+        assert!(p.equilibrium_residual <= EQUILIBRIUM_TOLERANCE, "{p:?}");
     }
 }

@@ -54,14 +54,17 @@ pub struct CurvePoint {
     /// Normwise backward error ‖Ax − b‖∞/(‖A‖∞‖x‖∞ + ‖b‖∞) of the increment's last linear
     /// solve (as `solve` reports it).
     pub backward_error: f64,
-    /// The increment's equilibrium residual ‖R‖/(‖K q‖ + ‖α F‖) with the contact law's own
-    /// forces (see [`crate::solve::IncrementRecord::equilibrium_residual`]).
+    /// The increment's equilibrium residual ‖R‖/(s + ‖α F‖) with the contact law's own
+    /// forces, s the forces the elements carry (see
+    /// [`crate::solve::IncrementRecord::equilibrium_residual`]).
     pub equilibrium_residual: f64,
     /// Contacts held in their state after chattering in this increment (their forces are the
     /// held state's, which the residual then measures).
     pub held: usize,
     /// State iterations of the increment.
     pub iterations: usize,
+    /// Times the increment was halved (see [`crate::solve::IncrementRecord::cutbacks`]).
+    pub cutbacks: usize,
     /// Work of the macroscopic resultants so far per unit cell area (J/m²), by the
     /// trapezoidal rule over the increments.
     pub external_work: f64,
@@ -216,6 +219,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             equilibrium_residual: r.equilibrium_residual,
             held: r.held,
             iterations: r.iterations,
+            cutbacks: r.cutbacks,
             external_work: r.energy.external_work / area,
             stored_energy: r.energy.stored / area,
             stabilization_energy: r.energy.stabilization / area,

@@ -8,6 +8,7 @@ use crate::contact::ContactState;
 use nalgebra::Vector2;
 
 /// Σ of the included contacts' loads, with the state and slip each was summed at.
+#[derive(Clone)]
 pub(crate) struct KeptContactLoads {
     states: Vec<ContactState>,
     slips: Vec<Vector2<f64>>,

@@ -20,7 +20,7 @@ pub(crate) use incremental::{run_incremental, OnAllStick};
 pub use incremental::{
     solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
     IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, BOUND_TOLERANCE,
-    EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS, MAX_HELD_RESIDUAL, MAX_INCREMENTS,
+    EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS,
     MAX_LOW_RANK_COLUMNS,
 };
 pub use job_system::{job_system, JobSystem};

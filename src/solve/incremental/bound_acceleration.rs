@@ -23,7 +23,7 @@ use std::collections::VecDeque;
 const DEPTH: usize = 5;
 
 /// The history of the fixed point on the bounds of one increment.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct BoundAcceleration {
     /// The contacts whose bounds are iterated (sliding in the last trial), ascending.
     sliding: Vec<usize>,

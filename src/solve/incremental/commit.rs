@@ -14,7 +14,7 @@ use nalgebra::{Vector2, Vector3};
 use rayon::prelude::*;
 
 /// What the energy balance carries from one increment to the next.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(super) struct EnergyHistory {
     /// Energy dissipated by sliding since the start.
     pub dissipated: f64,
@@ -158,6 +158,7 @@ impl StickSlip<'_, '_> {
                 columns: factors.low_rank.len(),
                 crossover_order: factors.cost.crossover(),
             },
+            cutbacks: 0,
             backward_error: bwd,
             equilibrium_residual,
             energy: balance,

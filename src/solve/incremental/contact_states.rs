@@ -10,6 +10,7 @@ use crate::contact::{BlockState, ContactPair, ContactState, Friction};
 use nalgebra::Vector2;
 
 /// Per contact, what the next system is assembled with and what the increment commits.
+#[derive(Clone)]
 pub(super) struct ContactStates {
     pub states: Vec<ContactState>,
     /// Unit slip directions of sliding contacts (tangent basis).

@@ -29,6 +29,7 @@ mod bound_acceleration;
 mod classify;
 mod commit;
 mod contact_states;
+mod cutback;
 mod driver_couplings;
 mod factor_reuse;
 mod factorize;
@@ -44,7 +45,7 @@ mod stabilizer;
 pub use driver_couplings::DriverCouplings;
 pub use options::{
     IncrementalOptions, Progress, BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS,
-    MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
+    MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
 };
 pub use records::{
     ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
@@ -112,8 +113,10 @@ pub(crate) fn run_incremental(
         )));
     }
     let mut solver = StickSlip::new(Setup::new(model, disc, set, opts)?, on_all_stick);
+    let mut from = 0.0;
     for (step, &alpha) in (1..).zip(&path) {
-        solver.increment(step, alpha)?;
+        solver.advance(step, (from, alpha), 0)?;
+        from = alpha;
         if let Some(p) = &opts.progress {
             (p.0)(step, path.len());
         }

@@ -80,6 +80,11 @@ pub struct IncrementalOptions {
     /// Cholesky and the low-rank corrections; at convergence both satisfy the same Coulomb
     /// law (`tests/curve_consistent_tangent.rs`).
     pub consistent_coulomb_tangent: bool,
+    /// Halvings of an increment that ends with contacts held off equilibrium (residual above
+    /// [`EQUILIBRIUM_TOLERANCE`]) or without equilibrium: it is redone from its start as two
+    /// halves, each of which may be halved again, down to 1/2^`max_cutbacks` of it (default
+    /// [`MAX_CUTBACKS`]; 0: never, the held state is committed as it is).
+    pub max_cutbacks: usize,
 }
 
 /// The relative change of a sliding Coulomb contact's bound c + μ max(N, 0) below which the
@@ -121,6 +126,7 @@ impl Default for IncrementalOptions {
             max_capacitance_order: None,
             deadline: None,
             consistent_coulomb_tangent: false,
+            max_cutbacks: MAX_CUTBACKS,
         }
     }
 }
@@ -141,6 +147,9 @@ pub const MAX_CONTACT_RECORDS: usize = 50_000_000;
 /// where the held state is a mechanism (a knitted cell with unilateral contacts, all of which
 /// open or slide under shear: its resultants then grew to 10¹⁴³).
 pub const MAX_HELD_RESIDUAL: f64 = 0.1;
+
+/// The default of [`IncrementalOptions::max_cutbacks`]: down to 1/16 of an increment.
+pub const MAX_CUTBACKS: usize = 4;
 
 /// State switches of one contact within an increment after which it is held in its state.
 pub(super) const CHATTER_SWITCHES: usize = 4;

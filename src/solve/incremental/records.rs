@@ -52,6 +52,10 @@ pub struct IncrementRecord {
     /// The sizes of the low-rank corrections (not serialized: they follow measured times).
     #[serde(skip)]
     pub low_rank: LowRankSizes,
+    /// Times the increment was halved because it ended with contacts held off equilibrium
+    /// (its halves' records are merged into this one: iterations and factorizations summed,
+    /// the attempts' included, the state at its end, the larger residual); 0: solved whole.
+    pub cutbacks: usize,
     /// Backward error of the last solve.
     pub backward_error: f64,
     /// Equilibrium residual ‖R‖₂ / (s + ‖α F‖₂) at the converged state, R on the free DOFs:
