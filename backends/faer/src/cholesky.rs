@@ -5,12 +5,11 @@
 //! `pivot_tolerance` is reported as [`SolverError::NotPositiveDefinite`] at the original column,
 //! which is how a mechanism (a fiber held by nothing) shows up instead of a garbage solution.
 
-use crate::block_solve::{
-    backward_in_place, forward_in_place, solve_in_place as block_solve, SolveSchedule,
-};
+use crate::block_kernels::SolveSchedule;
+use crate::block_solve::{backward_in_place, forward_in_place, solve_in_place as block_solve};
+use crate::block_tree::{BlockTree, FactorView};
 use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
-use crate::sparse_forward::{BlockTree, FactorView};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};

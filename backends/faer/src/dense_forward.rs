@@ -7,9 +7,9 @@
 //! column of their kernels, so that those blocks of L are read once (see
 //! [`crate::sparse_forward`]).
 
-use crate::block_solve::{forward_block, top_par, Shared, SolveSchedule};
+use crate::block_kernels::{forward_block, top_par, Shared, SolveSchedule};
+use crate::block_tree::{BlockTree, NONE};
 use crate::prefetch::prefetch_block;
-use crate::sparse_forward::{BlockTree, NONE};
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::Par;
 use rayon::prelude::*;

@@ -5,7 +5,7 @@
 //! next block before the current one is solved overlaps its first cache misses with that work:
 //! on L, each half solve 42 → 40 ms (medians of 12 solves each, alternating, on one factor).
 
-use crate::sparse_forward::BlockTree;
+use crate::block_tree::BlockTree;
 
 /// Bytes from a block's start requested ahead; past them the hardware prefetcher follows the
 /// block's stream.

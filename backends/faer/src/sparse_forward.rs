@@ -1,20 +1,18 @@
 //! Forward solves with sparse right-hand sides on faer's Cholesky factor, restricted to the
 //! elimination-tree paths of the nonzeros (Gilbert–Peierls reach, by blocks of L).
 
-use crate::block_solve::SolveSchedule;
+use crate::block_kernels::SolveSchedule;
+use crate::block_tree::{row_idx, BlockTree, FactorView, NONE};
 use crate::column_layout::ColumnLayout;
 use crate::dense_forward::{DenseForward, ForwardCursor};
 use crate::top_columns::TopColumns;
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{Reborrow, ReborrowMut};
-use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
+use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::{Accum, MatMut, MatRef, Par};
 use fibercell_solver::{ForwardBlock, ForwardColumns, SolverError};
 use rayon::prelude::*;
-use std::ops::Range;
-
-pub(crate) const NONE: usize = usize::MAX;
 
 /// Products of a block below which the dense kernels run single-threaded.
 const PARALLEL_FLOPS: usize = 1 << 20;
@@ -22,129 +20,7 @@ const PARALLEL_FLOPS: usize = 1 << 20;
 /// thread (on L at 1 %: the tasks' phase 51-53 → 46-50 ms).
 const TASK_BALANCE: f64 = 1.1;
 
-/// A numeric LLᵀ factor as the solves read it.
-#[derive(Clone, Copy)]
-pub(crate) struct FactorView<'a> {
-    pub(crate) symbolic: &'a SymbolicCholesky<usize>,
-    /// The values of L.
-    pub(crate) values: &'a [f64],
-    /// The inverse fill-reducing permutation, `inv[old] = new`.
-    pub(crate) inv: &'a [usize],
-    /// The scaling Ŝ.
-    pub(crate) scale: &'a [f64],
-}
-
-/// The block tree of a factor: faer's supernodes, or single columns for a simplicial factor.
-pub(crate) struct BlockTree {
-    /// The block holding each column of L.
-    pub(crate) block_of: Vec<usize>,
-    /// Each block's parent (the block of its first off-diagonal row), `NONE` at a root.
-    pub(crate) parent: Vec<usize>,
-    /// Where each block lies.
-    pub(crate) shapes: Vec<BlockShape>,
-}
-
-/// One block of L: first column, width, off-diagonal rows, values (rows × width, column-major,
-/// the diagonal block on top).
-pub(crate) struct Block<'a> {
-    pub(crate) begin: usize,
-    pub(crate) width: usize,
-    pub(crate) pattern: &'a [usize],
-    pub(crate) values: &'a [f64],
-}
-
-/// Where block `s` lies: first column, width, its off-diagonal rows (a range of the factor's
-/// row indices) and its values.
-#[derive(Clone, Debug)]
-pub(crate) struct BlockShape {
-    pub(crate) begin: usize,
-    pub(crate) width: usize,
-    pattern: Range<usize>,
-    pub(crate) values: Range<usize>,
-}
-
-fn raw_shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> BlockShape {
-    match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(f) => {
-            let (p, q) = (f.col_ptr()[s], f.col_ptr()[s + 1]);
-            BlockShape {
-                begin: s,
-                width: 1,
-                pattern: p + 1..q,
-                values: p..q,
-            }
-        }
-        SymbolicCholeskyRaw::Supernodal(f) => {
-            let begin = f.supernode_begin()[s];
-            let first = f.col_ptr_for_row_idx()[s];
-            BlockShape {
-                begin,
-                width: f.supernode_end()[s] - begin,
-                pattern: first..first + f.supernode(s).pattern().len(),
-                values: f.col_ptr_for_val()[s]..f.col_ptr_for_val()[s + 1],
-            }
-        }
-    }
-}
-
-/// The row indices the block patterns index into.
-fn row_idx(symbolic: &SymbolicCholesky<usize>) -> &[usize] {
-    match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(f) => f.row_idx(),
-        SymbolicCholeskyRaw::Supernodal(f) => f.row_idx(),
-    }
-}
-
-fn block_count(symbolic: &SymbolicCholesky<usize>) -> usize {
-    match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(f) => f.ncols(),
-        SymbolicCholeskyRaw::Supernodal(f) => f.n_supernodes(),
-    }
-}
-
 impl BlockTree {
-    /// The tree of `symbolic` (its values are not read).
-    pub(crate) fn of(symbolic: &SymbolicCholesky<usize>) -> Self {
-        let n = symbolic.nrows();
-        let blocks = block_count(symbolic);
-        let mut block_of = vec![NONE; n];
-        let shapes: Vec<BlockShape> = (0..blocks).map(|s| raw_shape(symbolic, s)).collect();
-        for (s, b) in shapes.iter().enumerate() {
-            block_of[b.begin..b.begin + b.width].fill(s);
-        }
-        let rows = row_idx(symbolic);
-        let parent = shapes
-            .iter()
-            .map(|b| {
-                rows[b.pattern.clone()]
-                    .iter()
-                    .min()
-                    .map_or(NONE, |&r| block_of[r])
-            })
-            .collect();
-        BlockTree {
-            block_of,
-            parent,
-            shapes,
-        }
-    }
-
-    /// Block `s` of the factor with values `values`.
-    pub(crate) fn block<'a>(
-        &self,
-        symbolic: &'a SymbolicCholesky<usize>,
-        values: &'a [f64],
-        s: usize,
-    ) -> Block<'a> {
-        let b = &self.shapes[s];
-        Block {
-            begin: b.begin,
-            width: b.width,
-            pattern: &row_idx(symbolic)[b.pattern.clone()],
-            values: &values[b.values.clone()],
-        }
-    }
-
     /// W = L⁻¹ P Ŝ B for the sparse columns `columns` (original row numbering) on `factor`,
     /// the subtrees of `schedule` on separate threads; with `rhs` (factor order) also its
     /// forward half `rhs` ← L⁻¹ `rhs`: in each block the columns read as one more column of
@@ -657,54 +533,12 @@ impl Walk<'_> {
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::{BlockTree, NONE};
+    use crate::test_matrices::{grid, grid_factor};
     use crate::{CholeskyVariant, FaerCholesky};
     use faer::Par;
-    use fibercell_solver::{CscMatrix, ForwardColumns, LinearSolver, Ordering, SolverError};
-
-    /// The order, the matrix and the supernodal nested-dissection LLᵀ factor of `grid(k)`.
-    pub(crate) fn grid_factor(k: usize) -> (usize, CscMatrix, FaerCholesky) {
-        let a = grid(k);
-        let mut s = FaerCholesky::new(CholeskyVariant::Llt, Ordering::NestedDissection);
-        s.analyze(a.as_ref()).unwrap();
-        s.factorize(a.as_ref()).unwrap();
-        (k * k * k, a, s)
-    }
-
-    /// A k³ grid Laplacian with edge weights and diagonal scales spread over four decades.
-    pub(crate) fn grid(k: usize) -> CscMatrix {
-        let id = |x: usize, y: usize, z: usize| (x * k + y) * k + z;
-        let weight = |a: usize, b: usize| 1.0 + ((a * 7919 + b * 104_729) % 97) as f64 / 10.0;
-        let scale = |a: usize| 10f64.powi((a % 5) as i32 - 2);
-        let mut t = Vec::new();
-        let mut diag = vec![0.1; k * k * k];
-        for x in 0..k {
-            for y in 0..k {
-                for z in 0..k {
-                    let a = id(x, y, z);
-                    for b in [
-                        (x + 1 < k).then(|| id(x + 1, y, z)),
-                        (y + 1 < k).then(|| id(x, y + 1, z)),
-                        (z + 1 < k).then(|| id(x, y, z + 1)),
-                    ]
-                    .into_iter()
-                    .flatten()
-                    {
-                        let w = weight(a, b);
-                        t.push((a, b, -w * scale(a) * scale(b)));
-                        t.push((b, a, -w * scale(a) * scale(b)));
-                        diag[a] += w;
-                        diag[b] += w;
-                    }
-                }
-            }
-        }
-        for (a, d) in diag.iter().enumerate() {
-            t.push((a, a, d * scale(a) * scale(a)));
-        }
-        CscMatrix::from_triplets(k * k * k, k * k * k, &t).unwrap()
-    }
+    use fibercell_solver::{ForwardColumns, LinearSolver, Ordering, SolverError};
 
     /// Sparse columns: single entries, a repeated column, entries far apart.
     fn columns(n: usize) -> Vec<Vec<(usize, f64)>> {
@@ -775,7 +609,7 @@ pub(crate) mod tests {
     /// and columns, values to 1e-12.
     #[test]
     fn sparse_forward_solve_on_subtree_tasks_matches_one_group() {
-        use crate::block_solve::SolveSchedule;
+        use crate::block_kernels::SolveSchedule;
         let (n, _, s) = grid_factor(16);
         let factor = s.factor_view();
         let tree = BlockTree::of(factor.symbolic);
@@ -816,7 +650,7 @@ pub(crate) mod tests {
     /// subtrees (unbalanced: that task's large blocks split over the threads).
     #[test]
     fn sparse_forward_solve_on_tasks_with_and_without_splits_matches_sequential() {
-        use crate::block_solve::SolveSchedule;
+        use crate::block_kernels::SolveSchedule;
         let (n, _, s) = grid_factor(20);
         let factor = s.factor_view();
         let tree = BlockTree::of(factor.symbolic);
@@ -886,7 +720,8 @@ pub(crate) mod tests {
     /// column leaves the right-hand side as it was.
     #[test]
     fn forward_solve_with_a_dense_right_hand_side_matches_the_two_apart() {
-        use crate::block_solve::{forward_in_place, SolveSchedule};
+        use crate::block_kernels::SolveSchedule;
+        use crate::block_solve::forward_in_place;
         let (n, _, mut s) = grid_factor(20);
         let b = spread_columns(n);
         let rhs: Vec<f64> = (0..n).map(|i| ((i * 37) % 23) as f64 - 11.0).collect();
@@ -1021,7 +856,7 @@ pub(crate) mod tests {
     /// grid with 47 columns) give the sequential result to 1e-12, on 2 and 3 threads.
     #[test]
     fn sparse_forward_solve_with_columns_split_over_threads_matches_sequential() {
-        use crate::block_solve::SolveSchedule;
+        use crate::block_kernels::SolveSchedule;
         let (n, _, s) = grid_factor(20);
         let factor = s.factor_view();
         let tree = BlockTree::of(factor.symbolic);
@@ -1085,7 +920,8 @@ pub(crate) mod tests {
     /// they were.
     #[test]
     fn forward_solve_with_columns_grouped_by_first_row_matches_dense_lower_solves() {
-        use crate::block_solve::{forward_in_place, SolveSchedule};
+        use crate::block_kernels::SolveSchedule;
+        use crate::block_solve::forward_in_place;
         let (n, _, mut s) = grid_factor(20);
         let b: Vec<Vec<(usize, f64)>> = (0..96)
             .map(|j| vec![((j * 7919) % n, 1.0 + j as f64 / 7.0)])

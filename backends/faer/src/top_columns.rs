@@ -6,7 +6,7 @@
 //! columns enter through one subtree only, so the private columns are few, instead of a private
 //! copy of every top block per task.
 
-use crate::sparse_forward::NONE;
+use crate::block_tree::NONE;
 use std::marker::PhantomData;
 
 /// Marks a column a task does not reach (and must not write).
