@@ -257,7 +257,15 @@ impl Scatter<'_, '_> {
                 if state != ContactState::Stick {
                     return;
                 }
-                let f = setup.pairs[i].stick_load(slip);
+                // The stick load as `contact_into` sums it (G φ), so updates cancel exactly.
+                let pair = &setup.pairs[i];
+                let stick = BlockState {
+                    state,
+                    direction: Vector2::zeros(),
+                    k_perp: 0.0,
+                };
+                let phi = pair.load_coefficients(&stick, &Vector2::zeros(), slip, setup.friction());
+                let f = pair.load_of(&phi);
                 for (r, ir) in super::factor_reuse::free_rows(&setup.pairs[i], setup.disc) {
                     out[ir] += sign * f[r];
                 }
