@@ -35,6 +35,7 @@ pub mod stats;
 
 pub use error::Error;
 pub use fibercell_solver as solver;
+pub use homogenize::{Cell, CellResponse, CellState};
 pub use model::Model;
 
 /// The Rust examples of the README and of `docs/`, compiled and run as doctests.

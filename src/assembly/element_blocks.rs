@@ -181,16 +181,34 @@ impl ElementBlocks {
     /// elements with the prescribed DOFs. The one right-hand side of every job.
     pub fn rhs(&self, model: &Model, disc: &Discretization) -> Vec<f64> {
         let mut rhs = Self::applied(model, disc);
-        if !disc.has_nonzero_prescribed() {
-            return rhs;
+        if disc.has_nonzero_prescribed() {
+            self.subtract_prescribed(model, disc, &|g| disc.prescribed_value(g), &mut rhs);
         }
+        rhs
+    }
+
+    /// −K_fc u_c for the values `u_c` per generalized DOF (read on prescribed DOFs only).
+    pub fn prescribed_load(&self, model: &Model, disc: &Discretization, u_c: &[f64]) -> Vec<f64> {
+        let mut rhs = vec![0.0; disc.n_free()];
+        self.subtract_prescribed(model, disc, &|g| u_c[g], &mut rhs);
+        rhs
+    }
+
+    /// rhs −= K_fc u_c, `value` giving u_c per generalized DOF.
+    fn subtract_prescribed(
+        &self,
+        model: &Model,
+        disc: &Discretization,
+        value: &dyn Fn(usize) -> f64,
+        rhs: &mut [f64],
+    ) {
         for e in 0..self.maps.len() {
             let gnodes = self.gnodes_of(model, e);
             let prescribed = |c: usize| {
                 let g = 6 * gnodes[c / 6] + c % 6;
                 disc.reduced(g)
                     .is_none()
-                    .then(|| disc.prescribed_value(g))
+                    .then(|| value(g))
                     .filter(|v| *v != 0.0)
             };
             if !(0..6 * gnodes.len()).any(|c| prescribed(c).is_some()) {
@@ -208,7 +226,6 @@ impl ElementBlocks {
                 }
             });
         }
-        rhs
     }
 
     /// Generalized internal forces K q for the full generalized vector q.

@@ -120,7 +120,7 @@ pub struct Curve {
 pub const MAX_MACRO_STRAIN: f64 = 0.5;
 
 /// Refuses strains beyond [`MAX_MACRO_STRAIN`] (curvatures times the larger period).
-fn check_small_strain(model: &Model, strain: &[f64; 6]) -> Result<(), Error> {
+pub(super) fn check_small_strain(model: &Model, strain: &[f64; 6]) -> Result<(), Error> {
     let period = model
         .cell
         .as_ref()

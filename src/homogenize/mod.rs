@@ -8,6 +8,7 @@ mod elastic;
 mod orthotropic;
 mod pressure;
 mod segments;
+mod stateful_cell;
 pub(crate) mod system;
 
 pub use curve::{
@@ -20,4 +21,5 @@ pub use elastic::{
 pub use orthotropic::{Orthotropic, ThesisModuli};
 pub use pressure::{default_pixel, pressure_load, PressureLoad};
 pub use segments::{segment_starting_at, Segment};
+pub use stateful_cell::{Cell, CellResponse, CellState};
 pub use system::{ContactStiffness, PeriodicSystem, PeriodicValues, SetupTimings};

@@ -294,6 +294,11 @@ impl LowRankCorrection {
         self.mode = ColumnMode::Unknown;
     }
 
+    /// Unknowns and contacts it was made for.
+    pub(crate) fn sizes(&self) -> (usize, usize) {
+        (self.n, self.owned.len())
+    }
+
     /// Columns of U so far.
     pub(crate) fn len(&self) -> usize {
         self.columns.len()

@@ -16,7 +16,7 @@ mod static_solve;
 pub use backend::{SolverConfig, SolverKind};
 pub use connectivity::{check_supported, check_supported_with};
 pub use increment_timings::IncrementTimings;
-pub(crate) use incremental::{run_incremental, OnAllStick};
+pub(crate) use incremental::{run_incremental, Advanced, OnAllStick, RunState, Setup};
 pub use incremental::{
     solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
     IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, BOUND_TOLERANCE,

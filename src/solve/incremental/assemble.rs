@@ -5,6 +5,7 @@
 
 use super::contact_states::ContactStates;
 use super::increment::Increment;
+use super::load_path::LoadPath;
 use super::setup::Setup;
 use super::StickSlip;
 use crate::assembly::SharedMut;
@@ -29,7 +30,7 @@ pub(super) struct System {
     pub nonsymmetric: bool,
 }
 
-impl StickSlip<'_, '_> {
+impl StickSlip<'_, '_, '_> {
     /// Assembles the system of the current contact states.
     pub(super) fn assemble(&mut self, inc: &mut Increment) -> Result<System, Error> {
         let StickSlip {
@@ -38,6 +39,7 @@ impl StickSlip<'_, '_> {
             factors,
             matrix,
             kept_loads,
+            path,
             ..
         } = self;
         let changes = factors
@@ -48,10 +50,11 @@ impl StickSlip<'_, '_> {
             matrix.changed_since_reference = None;
             matrix.values.copy_from_slice(&setup.k_elastic);
         }
-        let mut rhs: Vec<f64> = setup.rhs_full.iter().map(|v| inc.alpha * v).collect();
+        let mut rhs = path.rhs(inc.alpha);
         let scatter = Scatter {
             setup,
             contacts,
+            path,
             alpha: inc.alpha,
         };
         if changes.is_none() {
@@ -59,7 +62,7 @@ impl StickSlip<'_, '_> {
             setup.contact_columns.add(
                 &setup.pairs,
                 &setup.pattern,
-                setup.disc,
+                &setup.disc,
                 &mut matrix.values,
                 None,
                 |i| contact_block(setup, contacts, i),
@@ -73,7 +76,7 @@ impl StickSlip<'_, '_> {
                 .filter(|&i| contacts.states[i] != ContactState::Open)
                 .map(|i| &setup.set.pairs[i].jump.nodes[..])
                 .collect();
-            check_supported_with(setup.model, &closed)?;
+            check_supported_with(&setup.model, &closed)?;
         }
         let nonsymmetric = contacts.consistent_coulomb()
             && !contacts.symmetric_step
@@ -138,6 +141,7 @@ fn contact_changes(
 struct Scatter<'s, 'a> {
     setup: &'s Setup<'a>,
     contacts: &'s ContactStates,
+    path: &'s LoadPath,
     alpha: f64,
 }
 
@@ -147,7 +151,7 @@ impl Scatter<'_, '_> {
     /// keeps concurrent calls on distinct nodes.
     fn contact_into(&self, i: usize, state: ContactState, sign: f64, rhs: &SharedMut<f64>) {
         let (setup, contacts, alpha) = (self.setup, self.contacts, self.alpha);
-        let disc = setup.disc;
+        let disc = &setup.disc;
         let pair = &setup.pairs[i];
         let block_state = BlockState {
             state,
@@ -159,7 +163,7 @@ impl Scatter<'_, '_> {
         let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
         let mut prescribed = BlockVector::zeros();
         for &c in &setup.prescribed[i] {
-            prescribed[c] = alpha * disc.prescribed_value(gdof(c));
+            prescribed[c] = self.path.value(gdof(c), alpha);
         }
         if prescribed.iter().any(|v| *v != 0.0) {
             let d = pair.block_coefficients(&block_state, friction, setup.stabilization);
@@ -218,7 +222,7 @@ impl Scatter<'_, '_> {
             for (ga, pa) in pair.jump_basis().iter().zip(phi.iter()) {
                 f += ga * *pa;
             }
-            for (r, ir) in super::factor_reuse::free_rows(pair, setup.disc) {
+            for (r, ir) in super::factor_reuse::free_rows(pair, &setup.disc) {
                 // SAFETY: one contact at a time.
                 unsafe { *shared_rhs.get(ir) += f[r] };
             }
@@ -266,7 +270,7 @@ impl Scatter<'_, '_> {
                 };
                 let phi = pair.load_coefficients(&stick, &Vector2::zeros(), slip, setup.friction());
                 let f = pair.load_of(&phi);
-                for (r, ir) in super::factor_reuse::free_rows(&setup.pairs[i], setup.disc) {
+                for (r, ir) in super::factor_reuse::free_rows(&setup.pairs[i], &setup.disc) {
                     out[ir] += sign * f[r];
                 }
             },

@@ -17,7 +17,7 @@ pub(super) struct Classified {
     pub forces_only: bool,
 }
 
-impl StickSlip<'_, '_> {
+impl StickSlip<'_, '_, '_> {
     /// [`StickSlip::classify`], with the changes dropped when, from state iteration
     /// [`SETTLE_BY_EQUILIBRIUM_AFTER`] on, they only say that sliding forces are off the law
     /// (no state, slip direction or sign of N moved) while the increment to load factor

@@ -45,7 +45,7 @@ struct CommittedContact {
     energy: (f64, f64),
 }
 
-impl StickSlip<'_, '_> {
+impl StickSlip<'_, '_, '_> {
     /// Commits the converged increment `inc` with the trials of its last classification.
     pub(super) fn commit(
         &mut self,
@@ -63,7 +63,7 @@ impl StickSlip<'_, '_> {
             out,
             ..
         } = self;
-        let (model, disc, alpha) = (setup.model, setup.disc, inc.alpha);
+        let (model, disc, alpha) = (&setup.model, &setup.disc, inc.alpha);
         let internal = setup.elastic.internal_with_scale(model, q);
         // The scale of the residual: the forces the elements carry, (Σ_e ‖K_e q_e‖²)^½ (at a
         // node their sum cancels: ‖K q‖ measured a woven cell's shear, its yarns turning
@@ -225,7 +225,7 @@ fn commit_contact(
     }
 }
 
-impl StickSlip<'_, '_> {
+impl StickSlip<'_, '_, '_> {
     /// The equilibrium residual the increment to load factor `alpha` would commit with the
     /// law's forces of `trials` at the current displacements, against the elements' nodal
     /// forces ‖K q‖ (the largest so far): stricter than the reported one (see
@@ -234,7 +234,7 @@ impl StickSlip<'_, '_> {
     /// forces (faer LU and Cholesky then differ by 6·10⁻⁸ on the knit's resultants).
     pub(super) fn equilibrium_residual(&self, alpha: f64, trials: &[Trial]) -> f64 {
         let (setup, q) = (&self.setup, &self.q[..]);
-        let mut forces = setup.elastic.internal(setup.model, q);
+        let mut forces = setup.elastic.internal(&setup.model, q);
         let scale = self.energy.nodal_scale.max(norm(&forces));
         let contact_forces: Vec<_> = setup
             .pairs
@@ -247,7 +247,7 @@ impl StickSlip<'_, '_> {
         for (pair, f) in setup.pairs.iter().zip(&contact_forces) {
             add_block(&mut forces, &pair.jump.nodes, f);
         }
-        relative_residual(setup.disc, &forces, (&setup.applied_free, alpha), scale)
+        relative_residual(&setup.disc, &forces, (&setup.applied_free, alpha), scale)
     }
 }
 

@@ -107,6 +107,17 @@ impl ContactStates {
         !self.bound_fixed_point && matches!(self.friction, Friction::Coulomb { mu, .. } if mu > 0.0)
     }
 
+    /// Whether contact i's normal force was compressive at its last classification (its
+    /// Coulomb bound then grows with it).
+    pub fn in_compression(&self, i: usize) -> bool {
+        match self.friction {
+            Friction::Coulomb { cohesion, .. } if self.bound_fixed_point => {
+                self.bounds[i] > cohesion
+            }
+            _ => self.compressed[i],
+        }
+    }
+
     /// What contact i's block is assembled from.
     pub fn block(&self, i: usize) -> BlockState {
         BlockState {
@@ -143,6 +154,13 @@ impl ContactStates {
             self.previous = Some((a1, converged, sliding));
         }
         self.last_alpha = Some(alpha);
+    }
+
+    /// Forgets the load factors of the bounds' predictor: the load path turned, and the
+    /// bounds are no longer linear in α across its start.
+    pub fn restart_path(&mut self) {
+        self.previous = None;
+        self.last_alpha = None;
     }
 
     /// A contact that chattered and is held in its state for the rest of the increment.

@@ -25,7 +25,7 @@ struct Snapshot {
     records: usize,
 }
 
-impl StickSlip<'_, '_> {
+impl StickSlip<'_, '_, '_> {
     /// Increment `step` from load factor `from` to `alpha`, halved where it ends with contacts
     /// held off equilibrium (residual above [`EQUILIBRIUM_TOLERANCE`]) or without equilibrium
     /// ([`Error::NoEquilibrium`]), `depth` halvings deep so far.

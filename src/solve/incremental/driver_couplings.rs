@@ -5,7 +5,7 @@
 use super::assemble::contact_block;
 use super::contact_states::ContactStates;
 use super::setup::Setup;
-use crate::contact::ContactState;
+use crate::contact::{ContactBlock, ContactState};
 use nalgebra::SMatrix;
 
 /// K_fE (per free unknown, its coupling to the six drivers) and K_EE of a periodic cell.
@@ -24,11 +24,20 @@ impl DriverCouplings {
     /// K_N + K_T^st + K_R, open ones as their stabilizer ε (K_N + K_T^st + K_R), the blocks the
     /// all-stick matrix is assembled with).
     pub(super) fn of(setup: &Setup<'_>, contacts: &ContactStates) -> Option<Self> {
-        let (model, disc) = (setup.model, setup.disc);
-        let driver = disc.driver()?;
         if contacts.states.contains(&ContactState::Slip) {
             return None;
         }
+        Self::with_blocks(setup, |i| contact_block(setup, contacts, i))
+    }
+
+    /// K_fE and K_EE with contact i's block `block(i)`, any state (None without a driver).
+    /// K_fE of the transposed blocks is K_Efᵀ (the elements are symmetric).
+    pub(super) fn with_blocks(
+        setup: &Setup<'_>,
+        block: impl Fn(usize) -> ContactBlock,
+    ) -> Option<Self> {
+        let (model, disc) = (&setup.model, &setup.disc);
+        let driver = disc.driver()?;
         let mut out = DriverCouplings {
             coupling: vec![[0.0; 6]; disc.n_free()],
             k_ee: SMatrix::zeros(),
@@ -57,9 +66,7 @@ impl DriverCouplings {
         out.k_ee +=
             setup
                 .contact_columns
-                .add_driver_columns(&setup.pairs, disc, &mut out.coupling, |i| {
-                    contact_block(setup, contacts, i)
-                });
+                .add_driver_columns(&setup.pairs, disc, &mut out.coupling, block);
         Some(out)
     }
 }

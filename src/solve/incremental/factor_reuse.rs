@@ -139,7 +139,7 @@ pub(super) fn low_rank_column(pair: &ContactPair, disc: &Discretization, k: usiz
     col
 }
 
-impl StickSlip<'_, '_> {
+impl StickSlip<'_, '_, '_> {
     /// Solves `system` on the reference factorization with the changed contacts as a low-rank
     /// correction, when there is a reference and the correction is predicted cheaper than a
     /// factorization (see [`super::factors::LowRankCost`]); `None` when it is not tried or
@@ -159,7 +159,7 @@ impl StickSlip<'_, '_> {
             matrix,
             ..
         } = self;
-        let opts = setup.opts;
+        let opts = &setup.opts;
         let (Some(changes), Some(a0), true) = (
             system.changes.as_deref(),
             factors.backends.reference.as_mut(),
@@ -181,7 +181,7 @@ impl StickSlip<'_, '_> {
             return Ok(None);
         }
         let locate = |e| setup.locate(e);
-        let column = |c: usize, k: usize| low_rank_column(&setup.pairs[c], setup.disc, k);
+        let column = |c: usize, k: usize| low_rank_column(&setup.pairs[c], &setup.disc, k);
         let x0 = match factors.reference_solution.take() {
             Some(x0) => {
                 low_rank
@@ -271,6 +271,7 @@ impl StickSlip<'_, '_> {
             factors,
             matrix,
             q,
+            path,
             ..
         } = self;
         let a0 = factors
@@ -290,7 +291,7 @@ impl StickSlip<'_, '_> {
         check_backward_error(&setup.opts.solve, r.backward_error, &inc.name())?;
         let refined = r.refinements > 0;
         if refined {
-            *q = setup.disc.generalized(&r.x, inc.alpha);
+            *q = path.generalized(&setup.disc, &r.x, inc.alpha);
         }
         Ok(Some((low_rank_report(&r), refined)))
     }

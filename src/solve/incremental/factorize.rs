@@ -14,7 +14,7 @@ use crate::solve::{SolverConfig, SolverKind};
 use crate::Error;
 use fibercell_solver::{solve_checked, SolveReport, SolverError};
 
-impl StickSlip<'_, '_> {
+impl StickSlip<'_, '_, '_> {
     /// Factorizes `system` if needed and solves it: the solution and its report (none without
     /// unknowns).
     pub(super) fn solve_direct(
@@ -27,6 +27,7 @@ impl StickSlip<'_, '_> {
             contacts,
             factors,
             matrix,
+            on_all_stick,
             ..
         } = self;
         let locate = |e| setup.locate(e);
@@ -105,7 +106,7 @@ impl StickSlip<'_, '_> {
                     .zip(&setup.pairs)
                     .all(|(s, p)| *s == ContactStates::initial(p, friction))
             {
-                if let Some(hook) = factors.on_all_stick.take() {
+                if let Some(hook) = on_all_stick.take() {
                     let couplings = DriverCouplings::of(setup, contacts);
                     hook(solver.as_mut(), a, couplings.as_ref())?;
                 }

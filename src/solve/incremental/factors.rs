@@ -1,7 +1,6 @@
 //! The factorizations of a stick/slip run: the backends, the reference factorization A₀ with
 //! the contact blocks it was built from, and the low-rank correction accumulated on it.
 
-use super::OnAllStick;
 use crate::contact::{BlockCoefficients, BlockState, ContactState, Friction};
 use crate::solve::affine_reference::AffineReferences;
 use crate::solve::low_rank::{LowRankCorrection, Reference};
@@ -20,6 +19,17 @@ pub(super) struct Backends {
     /// The reference factorization A₀ of the low-rank solves, kept apart from `symmetric`
     /// so that direct solves in between do not discard the correction's columns.
     pub reference: Option<Box<dyn LinearSolver>>,
+    /// A stateful cell's consistent tangent matrix (nonsymmetric?, its solver), apart from
+    /// the run's so that computing a tangent changes no increment.
+    pub tangent: Option<TangentSolver>,
+}
+
+/// The solver of a stateful cell's tangent matrices, analyzed on the first.
+pub(super) struct TangentSolver {
+    /// LU for nonsymmetric tangents, else the run's symmetric backend.
+    pub nonsymmetric: bool,
+    pub solver: Box<dyn LinearSolver>,
+    pub analyzed: bool,
 }
 
 /// What a factorization and the capacitance factorization cost in this run, measured: a
@@ -62,7 +72,7 @@ pub(super) struct ReferenceBlock {
 }
 
 /// The factorizations and what the low-rank solves keep on the reference.
-pub(super) struct Factors<'h> {
+pub(super) struct Factors {
     pub backends: Backends,
     /// Set when the correction outgrew its columns or missed its accuracy: the next symmetric
     /// factorization becomes the new reference.
@@ -80,12 +90,10 @@ pub(super) struct Factors<'h> {
     pub low_rank: LowRankCorrection,
     /// The references of earlier increments' b₀ on it, when b₀ is affine in α.
     pub affine: AffineReferences,
-    /// Told about the first reference factorization when it is the all-stick matrix.
-    pub on_all_stick: Option<OnAllStick<'h>>,
 }
 
-impl<'h> Factors<'h> {
-    pub fn new(n_free: usize, contacts: usize, on_all_stick: Option<OnAllStick<'h>>) -> Self {
+impl Factors {
+    pub fn new(n_free: usize, contacts: usize) -> Self {
         Factors {
             backends: Backends::default(),
             refresh_reference: false,
@@ -98,7 +106,12 @@ impl<'h> Factors<'h> {
             reference_solution: None,
             low_rank: LowRankCorrection::new(n_free, contacts),
             affine: AffineReferences::default(),
-            on_all_stick,
         }
+    }
+
+    /// New, empty factors of the same sizes (a copied state's own caches).
+    pub fn emptied(&self) -> Self {
+        let (n_free, contacts) = self.low_rank.sizes();
+        Factors::new(n_free, contacts)
     }
 }

@@ -1,6 +1,7 @@
 //! What one load increment keeps across its state iterations: its load factor, the jumps of
 //! the prescribed DOFs, the base load of its assemblies, and its counters and clocks.
 
+use super::load_path::LoadPath;
 use super::setup::Setup;
 use crate::contact::ContactState;
 use crate::solve::IncrementTimings;
@@ -30,9 +31,8 @@ pub(super) struct Increment {
 }
 
 impl Increment {
-    pub fn new(setup: &Setup<'_>, step: usize, alpha: f64) -> Self {
+    pub fn new(setup: &Setup<'_>, path: &LoadPath, step: usize, alpha: f64) -> Self {
         let started = Instant::now();
-        let disc = setup.disc;
         let prescribed_jump = setup
             .pairs
             .iter()
@@ -46,7 +46,7 @@ impl Increment {
                     cols.iter()
                         .map(|&c| {
                             let gdof = 6 * p.jump.nodes[c / 6] + c % 6;
-                            g[b][c] * alpha * disc.prescribed_value(gdof)
+                            g[b][c] * path.value(gdof, alpha)
                         })
                         .sum()
                 })

@@ -26,6 +26,7 @@
 
 mod assemble;
 mod bound_acceleration;
+mod cell_tangent;
 mod classify;
 mod commit;
 mod contact_states;
@@ -35,10 +36,12 @@ mod factor_reuse;
 mod factorize;
 mod factors;
 mod increment;
+mod load_path;
 mod matrix_values;
 mod options;
 mod records;
 mod return_mapping;
+mod run_state;
 mod setup;
 mod stabilizer;
 
@@ -57,9 +60,11 @@ use commit::EnergyHistory;
 use contact_states::ContactStates;
 use factors::Factors;
 use increment::Increment;
+use load_path::LoadPath;
 use matrix_values::MatrixValues;
 use options::CHATTER_SWITCHES;
-use setup::Setup;
+pub(crate) use run_state::{Advanced, RunState};
+pub(crate) use setup::Setup;
 
 use super::kept_contact_loads::KeptContactLoads;
 use super::low_rank::Capacitance;
@@ -69,6 +74,7 @@ use crate::contact::{ContactSet, ContactSide};
 use crate::model::Model;
 use crate::Error;
 use fibercell_solver::{CscRef, LinearSolver, SolveReport};
+use std::borrow::Cow;
 
 /// Runs the incremental stick/slip analysis of `model` (its supports, loads and contacts).
 pub fn solve_incremental(
@@ -112,7 +118,13 @@ pub(crate) fn run_incremental(
             MAX_CONTACT_RECORDS
         )));
     }
-    let mut solver = StickSlip::new(Setup::new(model, disc, set, opts)?, on_all_stick);
+    let setup = Setup::new(
+        Cow::Borrowed(model),
+        Cow::Borrowed(disc),
+        set,
+        Cow::Borrowed(opts),
+    )?;
+    let mut solver = StickSlip::new(&setup, on_all_stick);
     let mut from = 0.0;
     for (step, &alpha) in (1..).zip(&path) {
         solver.advance(step, (from, alpha), 0)?;
@@ -159,10 +171,10 @@ fn load_path(opts: &IncrementalOptions) -> Result<Vec<f64>, Error> {
 
 /// The stick/slip solver of one run (thesis §4.3): its fixed data, the contacts' states, the
 /// factorizations and matrix values, and the results so far.
-pub(crate) struct StickSlip<'a, 'h> {
-    setup: Setup<'a>,
+pub(crate) struct StickSlip<'s, 'a, 'h> {
+    setup: &'s Setup<'a>,
     contacts: ContactStates,
-    factors: Factors<'h>,
+    factors: Factors,
     matrix: MatrixValues,
     /// The loads of the contacts without prescribed DOFs in their base states (open as open,
     /// the others stuck) with the slips they were summed at: kept across increments and
@@ -173,6 +185,10 @@ pub(crate) struct StickSlip<'a, 'h> {
     q: Vec<f64>,
     energy: EnergyHistory,
     out: IncrementalSolution,
+    /// The prescribed values and elastic load along α.
+    path: LoadPath,
+    /// Told about the first reference factorization when it is the all-stick matrix.
+    on_all_stick: Option<OnAllStick<'h>>,
 }
 
 /// A state iteration's solution: the unknowns, the solve's report (none while a low-rank
@@ -183,12 +199,14 @@ struct Solved {
     unchecked: Option<Capacitance>,
 }
 
-impl<'a, 'h> StickSlip<'a, 'h> {
-    fn new(setup: Setup<'a>, on_all_stick: Option<OnAllStick<'h>>) -> Self {
+impl<'s, 'a, 'h> StickSlip<'s, 'a, 'h> {
+    fn new(setup: &'s Setup<'a>, on_all_stick: Option<OnAllStick<'h>>) -> Self {
         let n = 6 * setup.disc.n_gnodes();
         StickSlip {
-            contacts: ContactStates::new(&setup),
-            factors: Factors::new(setup.n_free(), setup.pairs.len(), on_all_stick),
+            contacts: ContactStates::new(setup),
+            path: LoadPath::new(setup),
+            factors: Factors::new(setup.n_free(), setup.pairs.len()),
+            on_all_stick,
             matrix: MatrixValues::new(&setup.k_elastic),
             kept_loads: None,
             q: vec![0.0; n],
@@ -210,7 +228,7 @@ impl<'a, 'h> StickSlip<'a, 'h> {
     /// Increment `step` to load factor `alpha`: state iterations — assemble, solve, classify
     /// — until no contact changes, then commit.
     fn increment(&mut self, step: usize, alpha: f64) -> Result<(), Error> {
-        let mut inc = Increment::new(&self.setup, step, alpha);
+        let mut inc = Increment::new(self.setup, &self.path, step, alpha);
         // New α and committed slips: a new reference load.
         self.factors.reference_solution = None;
         self.contacts.switches.fill(0);
@@ -329,15 +347,17 @@ impl<'a, 'h> StickSlip<'a, 'h> {
         check_backward_error(&self.setup.opts.solve, bwd, &inc.name())?;
         inc.lap(|t| &mut t.solve);
         if solved.x.iter().any(|v| !v.is_finite()) {
-            return Err(non_finite_solution(self.setup.model, &inc.name()));
+            return Err(non_finite_solution(&self.setup.model, &inc.name()));
         }
-        self.q = self.setup.disc.generalized(&solved.x, inc.alpha);
+        self.q = self
+            .path
+            .generalized(&self.setup.disc, &solved.x, inc.alpha);
         Ok(solved)
     }
 
     /// Contact i with its two sides, for error messages.
     fn describe(&self, i: usize) -> String {
-        let (model, set) = (self.setup.model, &self.setup.set);
+        let (model, set) = (&self.setup.model, &self.setup.set);
         let o = &set.origins[i];
         let side = |s: ContactSide| match s {
             ContactSide::Node(n) => format!("node {}", model.nodes[n].id),

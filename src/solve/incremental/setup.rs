@@ -13,17 +13,19 @@ use crate::solve::SolverConfig;
 use crate::Error;
 use fibercell_solver::SolverError;
 use nalgebra::{Vector2, Vector3};
+use std::borrow::Cow;
 
-/// Everything of a run that does not change with the increments.
-pub(super) struct Setup<'a> {
-    pub model: &'a Model,
-    pub disc: &'a Discretization,
-    pub opts: &'a IncrementalOptions,
+/// Everything of a run that does not change with the increments: borrowed by a run, owned
+/// (`Setup<'static>`) by a [`crate::Cell`] whose states run on it.
+pub(crate) struct Setup<'a> {
+    pub model: Cow<'a, Model>,
+    pub disc: Cow<'a, Discretization>,
+    pub opts: Cow<'a, IncrementalOptions>,
     /// The contacts as found (pairs on the model's nodes, origins).
     pub set: ContactSet,
     /// Contact jumps on generalized nodes: B T.
     pub pairs: Vec<ContactPair>,
-    pub law: Law,
+    pub(super) law: Law,
     /// Coulomb sliding by a fixed point on the bounds (see
     /// [`IncrementalOptions::consistent_coulomb_tangent`]).
     pub bound_fixed_point: bool,
@@ -61,10 +63,10 @@ pub(super) struct Setup<'a> {
 impl<'a> Setup<'a> {
     /// Checks the options and builds the run's fixed data.
     pub fn new(
-        model: &'a Model,
-        disc: &'a Discretization,
+        model: Cow<'a, Model>,
+        disc: Cow<'a, Discretization>,
         set: ContactSet,
-        opts: &'a IncrementalOptions,
+        opts: Cow<'a, IncrementalOptions>,
     ) -> Result<Self, Error> {
         if opts.max_state_iterations == 0 {
             return Err(Error::InvalidOption(
@@ -84,11 +86,11 @@ impl<'a> Setup<'a> {
         let bonded = opts.bonded || model.contact.as_ref().is_some_and(|c| c.bonded);
         let bound_fixed_point = matches!(friction, Friction::Coulomb { mu, .. } if mu > 0.0)
             && !opts.consistent_coulomb_tangent;
-        let fixed = fixed_directions(model, disc, &set, opts)?;
+        let fixed = fixed_directions(&model, &disc, &set, &opts)?;
         let pairs: Vec<ContactPair> = set.pairs.iter().map(|p| disc.contact_pair(p)).collect();
-        let elastic = ElementBlocks::new(model, disc);
+        let elastic = ElementBlocks::new(&model, &disc);
         let mut blocks: Vec<Vec<usize>> = (0..model.elements().len())
-            .map(|e| elastic.gnodes_of(model, e).to_vec())
+            .map(|e| elastic.gnodes_of(&model, e).to_vec())
             .collect();
         blocks.extend(pairs.iter().map(|p| p.jump.nodes.clone()));
         let block_refs: Vec<&[usize]> = blocks.iter().map(|b| &b[..]).collect();
@@ -99,7 +101,7 @@ impl<'a> Setup<'a> {
             model.elements().len(),
         )?;
         let mut k_elastic = vec![0.0; pattern.nnz()];
-        elastic.fill(model, &pattern, &mut k_elastic, opts.solve.fill)?;
+        elastic.fill(&model, &pattern, &mut k_elastic, opts.solve.fill)?;
         let contact_colors = color_blocks(
             disc.n_gnodes(),
             pairs.iter().map(|p| &p.jump.nodes[..]),
@@ -123,9 +125,13 @@ impl<'a> Setup<'a> {
             && solver_config
                 .build()
                 .is_ok_and(|s| !s.capabilities().iterative);
+        let (length_tol, direction_tol) = (
+            1e-12 * model.size(),
+            SLIP_DIRECTION_TOLERANCE * model.size(),
+        );
         Ok(Setup {
-            rhs_full: elastic.rhs(model, disc),
-            applied_free: ElementBlocks::applied(model, disc),
+            rhs_full: elastic.rhs(&model, &disc),
+            applied_free: ElementBlocks::applied(&model, &disc),
             model,
             disc,
             opts,
@@ -143,8 +149,8 @@ impl<'a> Setup<'a> {
             prescribed,
             solver_config,
             low_rank_possible,
-            length_tol: 1e-12 * model.size(),
-            direction_tol: SLIP_DIRECTION_TOLERANCE * model.size(),
+            length_tol,
+            direction_tol,
             stabilization,
         })
     }
@@ -161,7 +167,7 @@ impl<'a> Setup<'a> {
 
     /// A solver error with its row named as a node and DOF of the model.
     pub fn locate(&self, e: SolverError) -> Error {
-        self.disc.locate(self.model, e)
+        self.disc.locate(&self.model, e)
     }
 }
 

@@ -1,0 +1,124 @@
+//! The consistent tangent of a converged stick/slip state for a macro-scale Newton iteration
+//! (FE²): dN/dE · area = K_EE − K_Ef K_ff⁻¹ K_fE (thesis 5.5) on the tangent matrix of the
+//! state — its contacts' states, slip directions and k⊥ held, and a Coulomb contact sliding in
+//! compression with its bound's slope, μ p_N d nᵀ (the bound c + μ N follows the normal force;
+//! the run's fixed point on the bounds leaves that term out of its matrices). That matrix is
+//! nonsymmetric then, and is factorized by LU.
+
+use super::driver_couplings::DriverCouplings;
+use super::factors::TangentSolver;
+use super::run_state::RunState;
+use super::setup::Setup;
+use crate::contact::{BlockCoefficients, ContactState, Friction};
+use crate::solve::static_solve::check_backward_error;
+use crate::solve::{SolverConfig, SolverKind};
+use crate::Error;
+use fibercell_solver::{solve_checked, SolverError};
+
+/// dN/dE times the cell area: rows N11, N22, N12, M11, M22, M12; columns the strains.
+pub(crate) type Tangent = [[f64; 6]; 6];
+
+impl RunState {
+    /// The consistent tangent (times the area) at the state's converged contact states.
+    pub fn tangent(&mut self, setup: &Setup<'_>) -> Result<Tangent, Error> {
+        let blocks: Vec<BlockCoefficients> = (0..setup.pairs.len())
+            .map(|i| {
+                setup.pairs[i].block_coefficients(
+                    &self.contacts.block(i),
+                    self.tangent_friction(setup, i),
+                    setup.stabilization,
+                )
+            })
+            .collect();
+        let nonsymmetric = blocks.iter().any(|d| *d != d.transpose());
+        let (pairs, disc) = (&setup.pairs, &setup.disc);
+        let mut values = setup.k_elastic.clone();
+        setup
+            .contact_columns
+            .add(pairs, &setup.pattern, disc, &mut values, None, |i| {
+                pairs[i].block_of(&blocks[i])
+            });
+        let columns = DriverCouplings::with_blocks(setup, |i| pairs[i].block_of(&blocks[i]))
+            .ok_or(Error::InvalidOption(
+                "the cell has no macroscopic driver".into(),
+            ))?;
+        let rows =
+            DriverCouplings::with_blocks(setup, |i| pairs[i].block_of(&blocks[i].transpose()))
+                .ok_or(Error::InvalidOption(
+                    "the cell has no macroscopic driver".into(),
+                ))?;
+        let a = setup.pattern.matrix(&values)?;
+        let n = disc.n_free();
+        let mut x = vec![0.0; 6 * n];
+        if n > 0 {
+            let tangent = self.tangent_solver(setup, nonsymmetric)?;
+            let locate = |e| setup.locate(e);
+            if !tangent.analyzed {
+                tangent.solver.analyze(a).map_err(locate)?;
+                tangent.analyzed = true;
+            }
+            tangent.solver.factorize(a).map_err(locate)?;
+            let rhs: Vec<f64> = (0..6)
+                .flat_map(|k| columns.coupling.iter().map(move |c| -c[k]))
+                .collect();
+            let (solution, report) =
+                solve_checked(tangent.solver.as_mut(), a, &rhs, 6).map_err(locate)?;
+            check_backward_error(
+                &setup.opts.solve,
+                report.backward_error,
+                "the cell's tangent",
+            )?;
+            x = solution;
+        }
+        Ok(std::array::from_fn(|j| {
+            std::array::from_fn(|k| {
+                let schur: f64 = (0..n).map(|i| rows.coupling[i][j] * x[k * n + i]).sum();
+                columns.k_ee[(j, k)] + schur
+            })
+        }))
+    }
+
+    /// The friction contact i's tangent block is built with: a Coulomb contact sliding in
+    /// compression (its bound above the cohesion) as Coulomb, one in tension at its cohesion
+    /// (Tresca), other laws as they are.
+    fn tangent_friction(&self, setup: &Setup<'_>, i: usize) -> Friction {
+        match setup.friction() {
+            Friction::Coulomb { cohesion, .. }
+                if self.contacts.states[i] == ContactState::Slip
+                    && !self.contacts.in_compression(i) =>
+            {
+                Friction::Tresca { bound: cohesion }
+            }
+            friction => friction,
+        }
+    }
+
+    /// The tangent's solver: LU when `nonsymmetric`, else the run's symmetric backend; kept
+    /// (analyzed once) while the symmetry stays.
+    fn tangent_solver(
+        &mut self,
+        setup: &Setup<'_>,
+        nonsymmetric: bool,
+    ) -> Result<&mut TangentSolver, Error> {
+        let slot = &mut self.factors.backends.tangent;
+        if slot.as_ref().is_none_or(|t| t.nonsymmetric != nonsymmetric) {
+            let kind = if nonsymmetric {
+                SolverKind::FaerLu
+            } else {
+                setup.opts.solve.solver
+            };
+            let solver = SolverConfig {
+                kind,
+                ..setup.solver_config.clone()
+            }
+            .build()?;
+            *slot = Some(TangentSolver {
+                nonsymmetric,
+                solver,
+                analyzed: false,
+            });
+        }
+        slot.as_mut()
+            .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "analyze")))
+    }
+}

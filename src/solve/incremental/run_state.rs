@@ -1,0 +1,218 @@
+//! A stick/slip run between increments, without its setup: what a [`crate::Cell`] keeps per
+//! material point. An increment resumes it on the cell's setup, advances it like a run's
+//! increment (with cutbacks) and parks it again; a failed or trial increment leaves its
+//! committed values as they were.
+
+use super::cell_tangent::Tangent;
+use super::commit::EnergyHistory;
+use super::contact_states::ContactStates;
+use super::factors::Factors;
+use super::load_path::LoadPath;
+use super::matrix_values::MatrixValues;
+use super::records::{IncrementRecord, IncrementalSolution};
+use super::setup::Setup;
+use super::StickSlip;
+use crate::solve::kept_contact_loads::KeptContactLoads;
+use crate::Error;
+
+/// An increment's record and, when asked for, the consistent tangent after it.
+pub(crate) struct Advanced {
+    pub record: IncrementRecord,
+    pub tangent: Option<Tangent>,
+}
+
+/// The committed state of a run (contact states, slips, displacements, energies, load path)
+/// and its caches (factorizations, matrix values), which any committed state may use.
+pub(crate) struct RunState {
+    pub(super) contacts: ContactStates,
+    pub(super) factors: Factors,
+    pub(super) matrix: MatrixValues,
+    pub(super) kept_loads: Option<KeptContactLoads>,
+    pub(super) q: Vec<f64>,
+    pub(super) energy: EnergyHistory,
+    /// The last increment's records only.
+    pub(super) out: IncrementalSolution,
+    pub(super) path: LoadPath,
+    /// Load factor on `path`.
+    pub alpha: f64,
+    /// Increments committed.
+    pub step: usize,
+}
+
+impl Clone for RunState {
+    /// The committed state with caches of its own, empty: its next increment factorizes
+    /// anew (its results equal the original's to the solver's tolerances, not bit for bit).
+    fn clone(&self) -> Self {
+        RunState {
+            matrix: MatrixValues::new(&self.matrix.values),
+            ..self.without_caches()
+        }
+    }
+}
+
+impl RunState {
+    /// At rest: every closed contact in stick, no slip, on the setup's own load path.
+    pub fn start(setup: &Setup<'_>) -> Self {
+        StickSlip::new(setup, None).park(0.0, 0)
+    }
+
+    /// Turns the load path at the current load factor: from here the prescribed values change
+    /// by `direction` (per generalized DOF) per unit α, and α restarts at 0.
+    fn turn(&mut self, setup: &Setup<'_>, direction: Vec<f64>) {
+        self.path.turn(setup, self.alpha, direction);
+        self.alpha = 0.0;
+        self.contacts.restart_path();
+        self.factors.affine.clear();
+    }
+
+    /// One increment to load factor `alpha` on the path (turned first to `turn`, see
+    /// [`RunState::turn`]), committed: its record, and with `tangent` the consistent tangent
+    /// there. On an error the committed state is as before (its caches emptied).
+    pub fn advance(
+        &mut self,
+        setup: &Setup<'_>,
+        turn: Option<Vec<f64>>,
+        alpha: f64,
+        tangent: bool,
+    ) -> Result<Advanced, Error> {
+        let committed = self.without_caches();
+        let mut run = std::mem::replace(self, committed);
+        if let Some(direction) = turn {
+            run.turn(setup, direction);
+        }
+        let (from, step) = (run.alpha, run.step + 1);
+        let mut solver = StickSlip::resume(setup, run);
+        let advanced = solver.advance(step, (from, alpha), 0);
+        let mut done = solver.park(alpha, step);
+        let result = advanced.and_then(|()| done.advanced(setup, tangent));
+        match result {
+            Ok(a) => {
+                *self = done;
+                Ok(a)
+            }
+            Err(e) => {
+                self.matrix = MatrixValues::new(&setup.k_elastic);
+                Err(e)
+            }
+        }
+    }
+
+    /// The increment [`RunState::advance`] takes, not committed: the committed state stays,
+    /// with the caches the trial built.
+    pub fn trial(
+        &mut self,
+        setup: &Setup<'_>,
+        turn: Option<Vec<f64>>,
+        alpha: f64,
+        tangent: bool,
+    ) -> Result<Advanced, Error> {
+        let mut run = self.without_caches();
+        std::mem::swap(&mut run.factors, &mut self.factors);
+        std::mem::swap(&mut run.matrix, &mut self.matrix);
+        let result = run.advance(setup, turn, alpha, tangent);
+        self.factors = run.factors;
+        self.matrix = run.matrix;
+        result
+    }
+
+    /// The last increment's record (the others dropped) and, with `tangent`, the tangent.
+    fn advanced(&mut self, setup: &Setup<'_>, tangent: bool) -> Result<Advanced, Error> {
+        self.keep_last_record();
+        let record = self
+            .out
+            .increments
+            .last()
+            .cloned()
+            .ok_or(Error::InvalidOption(
+                "the increment committed no record".into(),
+            ))?;
+        let tangent = if tangent {
+            Some(self.tangent(setup)?)
+        } else {
+            None
+        };
+        Ok(Advanced { record, tangent })
+    }
+
+    /// The committed values with empty caches (no matrix values: the next increment assembles
+    /// them from the elastic ones, as without a reference factorization).
+    fn without_caches(&self) -> Self {
+        RunState {
+            contacts: self.contacts.clone(),
+            factors: self.factors.emptied(),
+            matrix: MatrixValues::new(&[]),
+            kept_loads: self.kept_loads.clone(),
+            q: self.q.clone(),
+            energy: self.energy.clone(),
+            out: self.out.clone(),
+            path: self.path.clone(),
+            alpha: self.alpha,
+            step: self.step,
+        }
+    }
+
+    /// Drops every record but the last increment's (a cell state lives for many increments).
+    fn keep_last_record(&mut self) {
+        let out = &mut self.out;
+        let keep = |n: usize| n.saturating_sub(1);
+        out.increments.drain(..keep(out.increments.len()));
+        out.contact_results.drain(..keep(out.contact_results.len()));
+        out.displacements.drain(..keep(out.displacements.len()));
+    }
+}
+
+impl<'s, 'a> StickSlip<'s, 'a, '_> {
+    /// Resumes `run` on `setup`.
+    pub(super) fn resume(setup: &'s Setup<'a>, run: RunState) -> Self {
+        let RunState {
+            contacts,
+            factors,
+            matrix,
+            kept_loads,
+            q,
+            energy,
+            out,
+            path,
+            ..
+        } = run;
+        StickSlip {
+            setup,
+            contacts,
+            factors,
+            matrix,
+            kept_loads,
+            q,
+            energy,
+            out,
+            path,
+            on_all_stick: None,
+        }
+    }
+
+    /// The run's state after `step` increments, at load factor `alpha`.
+    pub(super) fn park(self, alpha: f64, step: usize) -> RunState {
+        let StickSlip {
+            contacts,
+            factors,
+            matrix,
+            kept_loads,
+            q,
+            energy,
+            out,
+            path,
+            ..
+        } = self;
+        RunState {
+            contacts,
+            factors,
+            matrix,
+            kept_loads,
+            q,
+            energy,
+            out,
+            path,
+            alpha,
+            step,
+        }
+    }
+}
