@@ -20,6 +20,15 @@ typedef enum FcStatus {
   FC_PANIC = 3,
 } FcStatus;
 
+// A periodic cell set up once (pairing, contacts, pattern, elastic values) for any number of
+// `FcCellState`s. Read-only after it is made: calls with different states may run on
+// different threads at once.
+typedef struct FcCell FcCell;
+
+// One material point of an `FcCell` (contact states, slips, energies, its factorizations).
+// One call at a time per state.
+typedef struct FcCellState FcCellState;
+
 // A validated model (fibers, nodes, materials, contacts, a cell or supports).
 typedef struct FcModel FcModel;
 
@@ -34,6 +43,39 @@ typedef struct FcSolveOptions {
   // "auto", "amd", "nd" or "natural".
   const char *ordering;
 } FcSolveOptions;
+
+// A state's response to a strain increment.
+typedef struct FcCellResponse {
+  // The macroscopic strain reached: e11, e22, g12, k11, k22, k12.
+  double strain[6];
+  // Averaged stress resultants N11, N22, N12 (N/m), M11, M22, M12 (N).
+  double resultant[6];
+  // The consistent tangent dN/dE, row-major (rows N11 … M12, columns e11 … k12); zeros
+  // unless `has_tangent`.
+  double tangent[36];
+  // Whether `tangent` was computed (the cell was made with `tangent` true).
+  bool has_tangent;
+  // Dissipated energy per unit cell area since the state's start (J/m²).
+  double dissipated;
+  // Elastic energy stored per unit area (J/m²).
+  double stored_energy;
+  // Contacts open, stuck and sliding.
+  uintptr_t open;
+  // Contacts stuck.
+  uintptr_t stick;
+  // Contacts sliding.
+  uintptr_t slip;
+  // State iterations of the increment.
+  uintptr_t iterations;
+  // Times the increment was halved.
+  uintptr_t cutbacks;
+  // Contacts held in their state after chattering.
+  uintptr_t held;
+  // The increment's equilibrium residual ‖R‖/‖F‖.
+  double equilibrium_residual;
+  // The energy balance's relative error.
+  double energy_error;
+} FcCellResponse;
 
 #ifdef __cplusplus
 extern "C" {
@@ -155,6 +197,67 @@ enum FcStatus fc_solver_solve(struct FcSolver *solver,
 // # Safety
 // `solver` is NULL or a handle from this library, not used afterwards.
 void fc_solver_free(struct FcSolver *solver);
+
+// Sets up the cell `model` (a periodic cell without supports or loads) with the solver
+// `opts` (NULL: the defaults); with `tangent`, responses carry the consistent tangent (one
+// factorization each).
+//
+// # Safety
+// `model` is a valid handle; `opts` is NULL or valid; `out` is valid for a write.
+enum FcStatus fc_cell_new(const struct FcModel *model,
+                          const struct FcSolveOptions *opts,
+                          bool tangent,
+                          struct FcCell **out);
+
+// Releases a cell (NULL: nothing); its states stay valid handles but no call accepts them.
+//
+// # Safety
+// `cell` is NULL or a handle from this library, not used afterwards.
+void fc_cell_free(struct FcCell *cell);
+
+// A state of `cell` at rest (zero strain, closed contacts stuck), in `*out`.
+//
+// # Safety
+// `cell` is a valid handle; `out` is valid for a write.
+enum FcStatus fc_cell_state_new(const struct FcCell *cell, struct FcCellState **out);
+
+// A copy of `state` in `*out` (its first update factorizes anew).
+//
+// # Safety
+// `state` is a valid handle; `out` is valid for a write.
+enum FcStatus fc_cell_state_clone(const struct FcCellState *state, struct FcCellState **out);
+
+// Releases a state (NULL: nothing).
+//
+// # Safety
+// `state` is NULL or a handle from this library, not used afterwards.
+void fc_cell_state_free(struct FcCellState *state);
+
+// The strain `state` is at (6 values: e11, e22, g12, k11, k22, k12) into `strain`.
+//
+// # Safety
+// `state` is a valid handle; `strain` holds 6 doubles.
+enum FcStatus fc_cell_state_strain(const struct FcCellState *state, double *strain);
+
+// Advances `state` by the strain `increment` (6 values) and commits it; the response in
+// `*response`. On an error the state is as it was.
+//
+// # Safety
+// `cell` and `state` are valid handles; `increment` holds 6 doubles; `response` is valid for
+// a write.
+enum FcStatus fc_cell_update(const struct FcCell *cell,
+                             struct FcCellState *state,
+                             const double *increment,
+                             struct FcCellResponse *response);
+
+// The response `fc_cell_update` would give, without committing it: `state` stays.
+//
+// # Safety
+// As `fc_cell_update`.
+enum FcStatus fc_cell_trial(const struct FcCell *cell,
+                            struct FcCellState *state,
+                            const double *increment,
+                            struct FcCellResponse *response);
 
 #ifdef __cplusplus
 }  // extern "C"

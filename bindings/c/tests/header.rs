@@ -29,6 +29,8 @@ fn the_committed_header_is_the_generated_one() {
         "fc_homogenize",
         "fc_curve",
         "fc_solver_factorize",
+        "fc_cell_update",
+        "FcCellResponse",
         "FC_OK",
     ] {
         assert!(generated.contains(name), "{name} is not in the header");

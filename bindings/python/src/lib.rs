@@ -1,9 +1,11 @@
-//! The Python extension `fibercell._fibercell`: models, the generators, `homogenize`, `curve`
-//! and the sparse solver layer. Results cross as the JSON the CLI prints (the same serializer,
+//! The Python extension `fibercell._fibercell`: models, the generators, `homogenize`, `curve`,
+//! the stateful cell (`Cell`, `CellState`) and the sparse solver layer. Results cross as the JSON the CLI prints (the same serializer,
 //! so the same digits); the Python package (`python/fibercell/__init__.py`) turns them into
 //! dictionaries with NumPy arrays. Every call that computes releases the GIL; every error is a
 //! `fibercell.FibercellError` (a `ValueError`) with the library's message, the text the CLI
 //! prints after `error:`.
+
+mod cell;
 
 use fibercell::homogenize::{elasto_plastic_curve, homogenize_elastic, CurveOptions};
 use fibercell::io;
@@ -289,6 +291,8 @@ fn _fibercell(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FibercellError", m.py().get_type::<FibercellError>())?;
     m.add_class::<Model>()?;
     m.add_class::<SparseSolver>()?;
+    m.add_class::<cell::Cell>()?;
+    m.add_class::<cell::CellState>()?;
     m.add_function(wrap_pyfunction!(generate_json, m)?)?;
     m.add_function(wrap_pyfunction!(homogenize_json, m)?)?;
     m.add_function(wrap_pyfunction!(curve_json, m)?)?;

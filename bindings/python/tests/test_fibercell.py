@@ -164,3 +164,67 @@ def test_computations_release_the_gil():
         done.set()
         t.join()
     assert len(ticks) > 100
+
+
+def test_cell_updates_are_the_cli_curve():
+    """Updates by E/N give `fibercell curve --strain E --steps N` to the last digit (E = 2⁻⁸,
+    N = 8: every strain is an exact binary fraction either way)."""
+    doc = run_json("curve", "fixtures/ok_cell_contact.toml", "--strain", "e11=0.00390625",
+                   "--steps", "8", "-d", str(ROOT / "target" / "pytest-cell-curve"))
+    model = fibercell.Model.load("fixtures/ok_cell_contact.toml")
+    cell = fibercell.Cell(model, tangent=False)
+    point = cell.new_state()
+    for p in doc["points"]:
+        r = cell.update(point, {"e11": 0.00390625 / 8})
+        assert r["strain"].tolist() == p["strain"]
+        assert r["resultant"].tolist() == p["resultant"]
+        assert r["dissipated"] == p["dissipated"]
+        assert (r["open"], r["stick"], r["slip"]) == (p["open"], p["stick"], p["slip"])
+        assert r["tangent"] is None
+    assert point.updates == len(doc["points"])
+
+
+def test_cell_trial_copy_threads_and_errors():
+    """On the grid cell (linear, A11 = E A / Ly): N11 = A11 ε11 and the tangent's A11 to 1e-9;
+    a trial commits nothing; a copy continues like the original; states updated from two
+    threads at once equal serial ones; bad increments and foreign states raise."""
+    grid = fibercell.Model.load("fixtures/ok_cell_grid.toml")
+    cell = fibercell.Cell(grid)
+    a11 = 1e9 * math.pi * 2e-4 ** 2 / 7e-3
+    point = cell.new_state()
+    r = cell.update(point, [1e-3, 0, 0, 0, 0, 0])
+    assert abs(r["resultant"][0] / (a11 * 1e-3) - 1) <= 1e-9
+    assert r["tangent"].shape == (6, 6) and abs(r["tangent"][0, 0] / a11 - 1) <= 1e-9
+    t = cell.trial(point, {"e22": 1e-3})
+    assert point.updates == 1 and point.strain.tolist() == [1e-3, 0, 0, 0, 0, 0]
+    copy = point.copy()
+    a = cell.update(point, {"e22": 1e-3})
+    b = cell.update(copy, {"e22": 1e-3})
+    assert abs(a["resultant"][1] / t["resultant"][1] - 1) <= 1e-12
+    assert abs(b["resultant"][1] / a["resultant"][1] - 1) <= 1e-12
+
+    states = [cell.new_state() for _ in range(2)]
+    steps = [{"e11": 1e-3}, {"g12": 1e-3}]
+    serial = [cell.update(cell.new_state(), s)["resultant"].tolist() for s in steps]
+    results = [None, None]
+
+    def run(k):
+        results[k] = cell.update(states[k], steps[k])["resultant"].tolist()
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert results == serial
+
+    other = fibercell.Cell(grid, tangent=False)
+    with pytest.raises(fibercell.FibercellError, match="another cell"):
+        other.update(point, {"e11": 1e-3})
+    with pytest.raises(fibercell.FibercellError, match="has 2 values: give 6"):
+        cell.update(point, [1e-3, 0])
+    with pytest.raises(fibercell.FibercellError, match="not finite"):
+        cell.update(point, [math.nan, 0, 0, 0, 0, 0])
+    with pytest.raises(fibercell.FibercellError, match="unknown strain"):
+        cell.update(point, {"e33": 1e-3})
+    assert point.updates == 2

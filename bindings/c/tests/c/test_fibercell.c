@@ -1,5 +1,6 @@
 /* The C ABI from C: models, homogenize against a closed form, the curve, the generators, the
- * solver layer on a small system with a known solution, and errors as statuses with messages.
+ * solver layer on a small system with a known solution, the stateful cell, and errors as
+ * statuses with messages.
  * Build and run from the repository root (see .ci/run):
  *   cargo build --release -p fibercell-c
  *   gcc -std=c11 -Wall -Wextra -Werror -I bindings/c/include bindings/c/tests/c/test_fibercell.c \
@@ -95,6 +96,59 @@ static void the_solver_layer_solves_a_known_system(void) {
     }
 }
 
+/* The stateful cell on the grid cell (no contacts: linear): N11 = A11 ε11 and dN11/dε11 = A11,
+ * A11 = E A / Ly; a trial commits nothing; a copy continues like the original; a state of
+ * another cell and a NaN increment are refused, leaving the state as it was. */
+static void the_stateful_cell_updates_and_tries(void) {
+    FcModel *grid = NULL;
+    CHECK(fc_model_load("fixtures/ok_cell_grid.toml", &grid) == FC_OK, "load");
+    FcCell *cell = NULL, *other = NULL;
+    CHECK(fc_cell_new(grid, NULL, true, &cell) == FC_OK, "cell");
+    CHECK(fc_cell_new(grid, NULL, false, &other) == FC_OK, "another cell");
+    FcCellState *state = NULL, *foreign = NULL, *copy = NULL;
+    CHECK(fc_cell_state_new(cell, &state) == FC_OK, "state");
+    CHECK(fc_cell_state_new(other, &foreign) == FC_OK, "a state of the other cell");
+    double a11 = 1e9 * M_PI * 2e-4 * 2e-4 / 7e-3;
+    const double de[6] = {1e-3, 0, 0, 0, 0, 0};
+    FcCellResponse r;
+    for (int k = 1; k <= 2; k++) {
+        CHECK(fc_cell_update(cell, state, de, &r) == FC_OK, "update %d", k);
+        CHECK(fabs(r.resultant[0] / (a11 * k * 1e-3) - 1.0) <= 1e-9, "N11 %.17g", r.resultant[0]);
+    }
+    CHECK(r.has_tangent && fabs(r.tangent[0] / a11 - 1.0) <= 1e-9, "dN11/de11 %.17g",
+          r.tangent[0]);
+    CHECK(r.slip == 0 && r.dissipated == 0.0, "no contact, no dissipation");
+    FcCellResponse t;
+    CHECK(fc_cell_trial(cell, state, de, &t) == FC_OK, "trial");
+    double strain[6];
+    CHECK(fc_cell_state_strain(state, strain) == FC_OK && strain[0] == 2e-3, "committed %g",
+          strain[0]);
+    CHECK(fc_cell_state_clone(state, &copy) == FC_OK, "clone");
+    FcCellResponse a, b;
+    CHECK(fc_cell_update(cell, state, de, &a) == FC_OK && fc_cell_update(cell, copy, de, &b) == FC_OK,
+          "both update");
+    CHECK(fabs(a.resultant[0] / t.resultant[0] - 1.0) <= 1e-12 &&
+              fabs(b.resultant[0] / a.resultant[0] - 1.0) <= 1e-12,
+          "trial %.17g, update %.17g, copy %.17g", t.resultant[0], a.resultant[0], b.resultant[0]);
+    CHECK(fc_cell_update(cell, foreign, de, &r) == FC_INVALID_ARGUMENT &&
+              strstr(fc_last_error(), "another cell") != NULL,
+          "foreign state: %s", fc_last_error());
+    const double nan_step[6] = {NAN, 0, 0, 0, 0, 0};
+    CHECK(fc_cell_update(cell, state, nan_step, &r) == FC_ERROR &&
+              strstr(fc_last_error(), "not finite") != NULL,
+          "NaN: %s", fc_last_error());
+    CHECK(fc_cell_state_strain(state, strain) == FC_OK && strain[0] == 3e-3, "unchanged %g",
+          strain[0]);
+    fc_cell_state_free(copy);
+    fc_cell_state_free(foreign);
+    fc_cell_state_free(state);
+    fc_cell_free(other);
+    fc_cell_free(cell);
+    fc_cell_free(NULL);
+    fc_cell_state_free(NULL);
+    fc_model_free(grid);
+}
+
 static void errors_are_statuses_with_messages(void) {
     FcModel *m = NULL;
     CHECK(fc_model_from_string("nodes = [", "toml", &m) == FC_ERROR && m == NULL, "bad TOML");
@@ -140,6 +194,7 @@ int main(void) {
     homogenize_matches_the_closed_form();
     curve_and_generators_run();
     the_solver_layer_solves_a_known_system();
+    the_stateful_cell_updates_and_tries();
     errors_are_statuses_with_messages();
     printf("test result: %s. %d passed; %d failed; C ABI %s\n", failed ? "FAILED" : "ok", passed,
            failed, fc_version());

@@ -2,7 +2,8 @@
 
 A thin layer over the Rust library (``fibercell._fibercell``): models from files, strings or
 dictionaries, the cell generators, the elastic homogenization (ABD), the friction-driven
-elasto-plastic curve and the sparse solver layer. Results are the documents the CLI prints
+elasto-plastic curve, the stateful cell of a macro-scale code (:class:`Cell`) and the sparse
+solver layer. Results are the documents the CLI prints
 with ``--json`` (the same serializer, the same digits), with NumPy arrays for the matrices and
 the curve's columns. Errors raise :class:`FibercellError` (a ``ValueError``) with the
 library's message; every computation releases the GIL.
@@ -17,14 +18,16 @@ library's message; every computation releases the GIL.
 from __future__ import annotations
 
 import json
-from typing import Any, Mapping, Optional, Tuple, Union
+from typing import Any, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from ._fibercell import FibercellError, Model, __version__
+from ._fibercell import CellState, FibercellError, Model, __version__
 from . import _fibercell
 
 __all__ = [
+    "Cell",
+    "CellState",
     "FibercellError",
     "Model",
     "SparseSolver",
@@ -108,6 +111,75 @@ def curve(
         ),
     }
     return doc
+
+
+def _increment(increment: Union[Sequence[float], Mapping[str, float]]) -> np.ndarray:
+    if isinstance(increment, Mapping):
+        unknown = [k for k in increment if k not in STRAIN_NAMES]
+        if unknown:
+            raise FibercellError(
+                f"unknown strain component(s) {unknown}: use {', '.join(STRAIN_NAMES)}"
+            )
+        return np.array([float(increment.get(k, 0.0)) for k in STRAIN_NAMES])
+    return np.ascontiguousarray(increment, dtype=np.float64).reshape(-1)
+
+
+class Cell:
+    """A periodic cell set up once for any number of material points (FE²): each
+    :class:`CellState` holds one point's contact states, slips and energies. ``update``
+    advances a state by a macroscopic strain increment (6 values e11, e22, g12, k11, k22, k12,
+    or a dict by those names) and commits it; ``trial`` gives the same response without
+    committing. A response is a dict: ``strain`` and ``resultant`` (6; N/m and N), ``tangent``
+    (6 × 6 consistent dN/dE, None with ``tangent=False``), ``dissipated`` and
+    ``stored_energy`` (J/m²), the contact counts ``open``, ``stick``, ``slip``, and the
+    increment's ``iterations``, ``cutbacks``, ``held``, ``equilibrium_residual`` and
+    ``energy_error``. Different states may be updated from different threads at once.
+
+    >>> import fibercell
+    >>> grid = fibercell.Model.load("fixtures/ok_cell_grid.toml")
+    >>> cell = fibercell.Cell(grid)
+    >>> point = cell.new_state()
+    >>> r = cell.update(point, {"e11": 1e-3})
+    >>> round(float(r["resultant"][0]), 4), round(r["tangent"][0, 0])  # A11 ε11, A11 = EA / Ly
+    (17.952, 17952)
+    >>> _ = cell.trial(point, {"e11": 1e-3}); point.updates  # a trial commits nothing
+    1
+    """
+
+    def __init__(
+        self,
+        model: Model,
+        solver: str = "faer-cholesky",
+        ordering: str = "auto",
+        tangent: bool = True,
+    ) -> None:
+        self._raw = _fibercell.Cell(model, solver=solver, ordering=ordering, tangent=tangent)
+
+    @property
+    def contacts(self) -> int:
+        """Contact pairs of the cell."""
+        return self._raw.contacts
+
+    @property
+    def area(self) -> float:
+        """Cell area L_x L_y (m²)."""
+        return self._raw.area
+
+    def new_state(self) -> CellState:
+        """A state at rest: zero strain, closed contacts stuck."""
+        return self._raw.new_state()
+
+    def update(
+        self, state: CellState, increment: Union[Sequence[float], Mapping[str, float]]
+    ) -> dict:
+        """Advances ``state`` by ``increment`` and commits it (on an error it stays)."""
+        return self._raw.update(state, _increment(increment))
+
+    def trial(
+        self, state: CellState, increment: Union[Sequence[float], Mapping[str, float]]
+    ) -> dict:
+        """The response ``update`` would give, without committing it."""
+        return self._raw.trial(state, _increment(increment))
 
 
 def _csc_arrays(a: Any) -> Tuple[int, np.ndarray, np.ndarray, np.ndarray]:
