@@ -236,7 +236,7 @@ fn the_stick_tangent_is_the_elastic_abd() {
 /// Sliding, the tangent is the derivative of the trial response with respect to the
 /// increment: central differences with h = 10⁻⁶ in each of the six components, from a state
 /// at ε11 = 3·10⁻³ (contacts sliding) and an increment (10⁻³, 2·10⁻⁴, 10⁻⁴, 0, 0, 0), agree
-/// to 10⁻⁶ of the largest entry (measured 9·10⁻⁸: the increments' equilibrium tolerance over
+/// to 10⁻⁶ of the largest entry (measured 2·10⁻⁸: the increments' equilibrium tolerance over
 /// h, and h² terms). No contact may switch between the trials, or the difference is not a
 /// derivative. Without the Coulomb slope μ p_N d nᵀ of the sliding contacts (the run's
 /// fixed-point matrix) the error is 4.9·10⁻⁴; with it the tangent is nonsymmetric by

@@ -112,6 +112,7 @@ fn dot(column: &SparseColumn, x: &[f64]) -> f64 {
 }
 
 /// The columns U and S = Uᵀ A₀⁻¹ U accumulated on one factorization A₀.
+#[derive(Clone)]
 pub(crate) struct LowRankCorrection {
     n: usize,
     columns: Vec<SparseColumn>,
@@ -124,6 +125,7 @@ pub(crate) struct LowRankCorrection {
 }
 
 /// How S's columns are computed.
+#[derive(Clone)]
 enum ColumnMode {
     /// Not known yet (no columns).
     Unknown,
@@ -135,6 +137,7 @@ enum ColumnMode {
 }
 
 /// The rows of W in one block of L, for every column so far that reaches it.
+#[derive(Clone)]
 struct StoredBlock {
     first_row: usize,
     rows: usize,
