@@ -279,3 +279,25 @@ fn the_sliding_tangent_is_the_derivative_of_the_response() {
         .fold(0.0f64, f64::max);
     println!("tangent FD error {worst:e}, asymmetry {asymmetry:e}");
 }
+
+/// A state whose caches were released continues like one that kept them, to the solver's
+/// tolerances (its next update factorizes anew), and its committed strain is unchanged.
+#[test]
+fn a_state_without_caches_continues_like_one_with_them() {
+    let cell = cell();
+    let mut kept = cell.new_state();
+    for _ in 0..4 {
+        cell.update(&mut kept, &e11(1e-3)).expect("update");
+    }
+    let mut released = kept.clone();
+    released.release_caches();
+    assert_eq!(released.strain(), kept.strain());
+    let a = cell.update(&mut kept, &e11(1e-3)).expect("update");
+    let b = cell.update(&mut released, &e11(1e-3)).expect("update");
+    let d = (a.resultant[0] - b.resultant[0]).abs();
+    assert!(d <= 1e-7 * a.resultant[0].abs(), "{d:e}");
+    assert_eq!((a.slip, a.stick), (b.slip, b.stick));
+    released.release_caches();
+    let c = cell.update(&mut released, &e11(1e-3)).expect("update");
+    assert!(c.resultant[0] > b.resultant[0]);
+}

@@ -54,6 +54,14 @@ impl CellState {
     pub fn updates(&self) -> usize {
         self.run.step
     }
+
+    /// Drops the state's factorizations and matrix values until its next update, which then
+    /// factorizes anew (and analyzes the pattern again): for many material points, whose
+    /// caches would not fit in memory together (on the S non-woven 67 MB a state with them,
+    /// 5.4 MB without). The committed state is unchanged.
+    pub fn release_caches(&mut self) {
+        self.run.release_caches();
+    }
 }
 
 /// The response of a cell state to a strain increment.

@@ -233,6 +233,13 @@ enum FcStatus fc_cell_state_clone(const struct FcCellState *state, struct FcCell
 // `state` is NULL or a handle from this library, not used afterwards.
 void fc_cell_state_free(struct FcCellState *state);
 
+// Drops the state's factorizations and matrix values until its next update, which then
+// factorizes anew: for many material points, whose caches would not fit in memory together.
+//
+// # Safety
+// `state` is a valid handle.
+enum FcStatus fc_cell_state_release_caches(struct FcCellState *state);
+
 // The strain `state` is at (6 values: e11, e22, g12, k11, k22, k12) into `strain`.
 //
 // # Safety

@@ -189,6 +189,21 @@ pub unsafe extern "C" fn fc_cell_state_free(state: *mut FcCellState) {
     }
 }
 
+/// Drops the state's factorizations and matrix values until its next update, which then
+/// factorizes anew: for many material points, whose caches would not fit in memory together.
+///
+/// # Safety
+/// `state` is a valid handle.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cell_state_release_caches(state: *mut FcCellState) -> FcStatus {
+    guard(|| {
+        // SAFETY: the caller's contract.
+        let s = unsafe { state.as_mut() }.ok_or_else(|| invalid("state is NULL"))?;
+        s.inner.release_caches();
+        Ok(())
+    })
+}
+
 /// The strain `state` is at (6 values: e11, e22, g12, k11, k22, k12) into `strain`.
 ///
 /// # Safety

@@ -13,7 +13,7 @@
 //! * Handles may be used from any thread, one call at a time per `FcSolver`; `FcModel` is
 //!   read-only after it is made and may be shared.
 
-mod cell;
+pub mod cell;
 
 pub use cell::{FcCell, FcCellResponse, FcCellState};
 

@@ -75,6 +75,19 @@ impl Cell {
         self.step(py, state, increment, true)
     }
 
+    /// `update`, and the seconds the library call took inside it (without the Python layer):
+    /// for measuring the binding's overhead.
+    fn timed_update<'py>(
+        &self,
+        py: Python<'py>,
+        state: &CellState,
+        increment: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<(Bound<'py, PyDict>, f64)> {
+        let mut seconds = 0.0;
+        let r = self.step_timed(py, state, increment, true, &mut seconds)?;
+        Ok((r, seconds))
+    }
+
     /// The response `update` would give, without committing it.
     fn trial<'py>(
         &self,
@@ -106,6 +119,18 @@ impl Cell {
         increment: PyReadonlyArray1<'py, f64>,
         commit: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
+        self.step_timed(py, state, increment, commit, &mut 0.0)
+    }
+
+    /// `step`, the library call's seconds in `seconds`.
+    fn step_timed<'py>(
+        &self,
+        py: Python<'py>,
+        state: &CellState,
+        increment: PyReadonlyArray1<'py, f64>,
+        commit: bool,
+        seconds: &mut f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
         if state.cell != self.id {
             return Err(error(
                 "state belongs to another cell: make it with new_state() of this cell",
@@ -122,11 +147,14 @@ impl Cell {
         let cell = &self.inner;
         let r = py
             .detach(|| {
-                if commit {
+                let started = std::time::Instant::now();
+                let r = if commit {
                     cell.update(s, &inc)
                 } else {
                     cell.trial(s, &inc)
-                }
+                };
+                *seconds = started.elapsed().as_secs_f64();
+                r
             })
             .map_err(error)?;
         response(py, &r)
@@ -180,6 +208,13 @@ impl CellState {
             inner: Mutex::new(s.clone()),
             cell: self.cell,
         })
+    }
+
+    /// Drops the state's factorizations and matrix values until its next update, which then
+    /// factorizes anew: for many material points, whose caches would not fit in memory.
+    fn release_caches(&self) -> PyResult<()> {
+        self.inner.lock().map_err(error)?.release_caches();
+        Ok(())
     }
 
     fn __copy__(&self) -> PyResult<CellState> {

@@ -43,10 +43,7 @@ impl Clone for RunState {
     /// The committed state with caches of its own, empty: its next increment factorizes
     /// anew (its results equal the original's to the solver's tolerances, not bit for bit).
     fn clone(&self) -> Self {
-        RunState {
-            matrix: MatrixValues::new(&self.matrix.values),
-            ..self.without_caches()
-        }
+        self.without_caches()
     }
 }
 
@@ -67,7 +64,7 @@ impl RunState {
 
     /// One increment to load factor `alpha` on the path (turned first to `turn`, see
     /// [`RunState::turn`]), committed: its record, and with `tangent` the consistent tangent
-    /// there. On an error the committed state is as before (its caches emptied).
+    /// there. On an error the committed state is as before (its caches released).
     pub fn advance(
         &mut self,
         setup: &Setup<'_>,
@@ -85,16 +82,10 @@ impl RunState {
         let advanced = solver.advance(step, (from, alpha), 0);
         let mut done = solver.park(alpha, step);
         let result = advanced.and_then(|()| done.advanced(setup, tangent));
-        match result {
-            Ok(a) => {
-                *self = done;
-                Ok(a)
-            }
-            Err(e) => {
-                self.matrix = MatrixValues::new(&setup.k_elastic);
-                Err(e)
-            }
+        if result.is_ok() {
+            *self = done;
         }
+        result
     }
 
     /// The increment [`RunState::advance`] takes, not committed: the committed state stays,
@@ -134,8 +125,8 @@ impl RunState {
         Ok(Advanced { record, tangent })
     }
 
-    /// The committed values with empty caches (no matrix values: the next increment assembles
-    /// them from the elastic ones, as without a reference factorization).
+    /// The committed values with empty caches (no matrix values: [`StickSlip::resume`] makes
+    /// them anew from the elastic ones, as without a reference factorization).
     fn without_caches(&self) -> Self {
         RunState {
             contacts: self.contacts.clone(),
@@ -151,6 +142,13 @@ impl RunState {
         }
     }
 
+    /// Drops the caches (factorizations, low-rank columns, matrix values): the committed state
+    /// alone stays, and the next increment factorizes anew.
+    pub fn release_caches(&mut self) {
+        self.factors = self.factors.emptied();
+        self.matrix = MatrixValues::new(&[]);
+    }
+
     /// Drops every record but the last increment's (a cell state lives for many increments).
     fn keep_last_record(&mut self) {
         let out = &mut self.out;
@@ -162,12 +160,12 @@ impl RunState {
 }
 
 impl<'s, 'a> StickSlip<'s, 'a, '_> {
-    /// Resumes `run` on `setup`.
+    /// Resumes `run` on `setup` (with matrix values again if its caches were released).
     pub(super) fn resume(setup: &'s Setup<'a>, run: RunState) -> Self {
         let RunState {
             contacts,
             factors,
-            matrix,
+            mut matrix,
             kept_loads,
             q,
             energy,
@@ -175,6 +173,9 @@ impl<'s, 'a> StickSlip<'s, 'a, '_> {
             path,
             ..
         } = run;
+        if matrix.values.len() != setup.k_elastic.len() {
+            matrix = MatrixValues::new(&setup.k_elastic);
+        }
         StickSlip {
             setup,
             contacts,

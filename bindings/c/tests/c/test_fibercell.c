@@ -124,6 +124,7 @@ static void the_stateful_cell_updates_and_tries(void) {
     CHECK(fc_cell_state_strain(state, strain) == FC_OK && strain[0] == 2e-3, "committed %g",
           strain[0]);
     CHECK(fc_cell_state_clone(state, &copy) == FC_OK, "clone");
+    CHECK(fc_cell_state_release_caches(copy) == FC_OK, "release the copy's caches");
     FcCellResponse a, b;
     CHECK(fc_cell_update(cell, state, de, &a) == FC_OK && fc_cell_update(cell, copy, de, &b) == FC_OK,
           "both update");
