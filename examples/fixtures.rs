@@ -7,10 +7,10 @@
 //! `cargo run --release --example fixtures`
 
 use fibercell::generate::{
-    nonwoven_preset, reference_results, CellParams, FiberAmount, FiberFamily, Geotextile, Knit,
-    LayerJunction, Weave, WeavePattern,
+    nonwoven_preset, CellParams, FiberAmount, FiberFamily, Geotextile, Knit, LayerJunction, Weave,
+    WeavePattern,
 };
-use fibercell::io::{to_toml, write_atomic};
+use fibercell::io::{reference_results, to_toml, write_atomic};
 use std::path::Path;
 
 fn catalog() -> Result<Vec<(&'static str, CellParams)>, fibercell::Error> {

@@ -1,6 +1,6 @@
 //! The crate-wide error type.
 
-use crate::io::InputError;
+use crate::input_error::InputError;
 use crate::model::{Dof, ModelError};
 use fibercell_solver::SolverError;
 

@@ -28,6 +28,7 @@ pub mod element;
 mod error;
 pub mod generate;
 pub mod homogenize;
+mod input_error;
 pub mod io;
 pub mod model;
 pub mod solve;

@@ -973,7 +973,9 @@ fn generate(kind: GenerateKind) -> Result<(), Error> {
             }
             generate_cell(CellParams::Geotextile(p), &output)
         }
-        GenerateKind::From { params, output } => generate_cell(CellParams::read(&params)?, &output),
+        GenerateKind::From { params, output } => {
+            generate_cell(fibercell::io::read_cell_params(&params)?, &output)
+        }
         GenerateKind::Knitted {
             params,
             wales,

@@ -8,8 +8,8 @@
 //! the same matrix differ by 1.2e-7 of the scale, and summing the entries of K in another order
 //! (the colored parallel fill against the earlier serial one) moves it by 1.2e-6.
 
-use fibercell::generate::{cell_digest, reference_results, CellParams, ReferenceResults};
 use fibercell::io::read_description;
+use fibercell::io::{cell_digest, read_cell_params, reference_results, ReferenceResults};
 use std::path::Path;
 
 const NAMES: [&str; 8] = [
@@ -28,7 +28,7 @@ const UNCOMMITTED: &str = "nonwoven_medium";
 
 fn check(name: &str) {
     let dir = Path::new("fixtures/cells");
-    let params = CellParams::read(&dir.join(format!("{name}.params.toml"))).unwrap();
+    let params = read_cell_params(&dir.join(format!("{name}.params.toml"))).unwrap();
     let cell = params.generate().unwrap();
     let text = std::fs::read_to_string(dir.join(format!("{name}.reference.json"))).unwrap();
     let want: ReferenceResults = serde_json::from_str(&text).unwrap();

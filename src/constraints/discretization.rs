@@ -144,7 +144,7 @@ impl Discretization {
     /// one (an unknown of a physical node).
     pub(crate) fn locate(&self, model: &Model, e: fibercell_solver::SolverError) -> crate::Error {
         let n = self.n_free();
-        crate::solve::locate(e, model, &|c: usize| (c < n).then(|| self.node_dof(c)))
+        super::locate(e, model, &|c: usize| (c < n).then(|| self.node_dof(c)))
     }
     /// (generalized node, DOF) of an unknown; the node is physical unless it is the driver.
     pub fn node_dof(&self, k: usize) -> (usize, Dof) {

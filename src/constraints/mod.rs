@@ -3,6 +3,8 @@
 
 mod discretization;
 mod loads;
+mod locate;
 
 pub use discretization::Discretization;
 pub use loads::{support_reactions, Reaction};
+pub(crate) use locate::locate;

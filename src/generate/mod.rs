@@ -11,7 +11,7 @@ mod segment_grid;
 mod woven;
 mod wrap;
 
-pub use catalog::{cell_digest, reference_results, CellParams, ReferenceResults};
+pub use catalog::CellParams;
 pub use geotextile::{geotextile, FiberFamily, Geotextile, LayerJunction};
 pub use grid::{clamped_grid, crossing_grid};
 pub use knitted::{knitted, Knit};

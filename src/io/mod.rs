@@ -5,8 +5,8 @@ mod abaqus;
 mod abaqus_cell;
 mod abaqus_export;
 mod atomic;
+mod catalog;
 mod curve_files;
-mod error;
 mod inp_number;
 mod matrix_market;
 mod native;
@@ -14,14 +14,15 @@ mod plot;
 mod results;
 mod vtk;
 
+pub use crate::input_error::InputError;
 pub use abaqus::{parse_abaqus, MAX_GENERATED_MEMBERS};
 pub use abaqus_export::{to_abaqus, to_inp, InpFlavour, InpOptions};
 pub use atomic::{begin_results, remove_unfinished_outputs, write_atomic};
+pub use catalog::{cell_digest, read_cell_params, reference_results, ReferenceResults};
 pub use curve_files::{
     curve_csv, curve_plot, dominant_component, switches_csv, write_curve_files, RESULTANT_NAMES,
     RESULTANT_UNITS, STRAIN_UNITS,
 };
-pub use error::InputError;
 pub use inp_number::{inp_number, MAX_FIELD};
 pub use matrix_market::{write_job_system, write_matrix_market, write_matrix_market_dense};
 pub use native::{parse_json, parse_toml, parse_toml_as, to_json, to_toml};

@@ -29,5 +29,5 @@ pub use matrix_solve::{
     solve_matrix, MatrixSolveReport, MatrixSolver, MATRIX_SOLVE_BACKWARD_ERROR,
 };
 pub use reduced::ReducedSystem;
-pub(crate) use static_solve::{check_backward_error, locate};
+pub(crate) use static_solve::check_backward_error;
 pub use static_solve::{solve_static, SolveOptions, SolveSummary, StaticSolution, Timings};

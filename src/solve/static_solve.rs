@@ -2,8 +2,8 @@
 
 use super::{check_supported, ReducedSystem, SolverConfig, SolverKind};
 use crate::assembly::FillMode;
-use crate::constraints::{support_reactions, Reaction};
-use crate::model::{Dof, Model};
+use crate::constraints::{locate, support_reactions, Reaction};
+use crate::model::Model;
 use crate::Error;
 use fibercell_solver::{solve_checked, Ordering, SolverError};
 use serde::Serialize;
@@ -105,29 +105,6 @@ pub struct StaticSolution {
     pub reactions: Vec<Reaction>,
     /// Solver report.
     pub summary: SolveSummary,
-}
-
-/// Maps a pivot failure at a reduced column to the node, DOF and fibers; `node_dof` gives the
-/// (node, DOF) of a column, `None` when it is not a physical node's DOF.
-pub(crate) fn locate(
-    e: SolverError,
-    model: &Model,
-    node_dof: &dyn Fn(usize) -> Option<(usize, Dof)>,
-) -> Error {
-    match e {
-        SolverError::NotPositiveDefinite { column, pivot } => {
-            match node_dof(column).filter(|(n, _)| *n < model.nodes.len()) {
-                Some((node, dof)) => Error::Singular {
-                    node: model.nodes[node].id,
-                    dof,
-                    fibers: model.fibers_at_node(node),
-                    pivot,
-                },
-                None => Error::Solver(SolverError::NotPositiveDefinite { column, pivot }),
-            }
-        }
-        other => Error::Solver(other),
-    }
 }
 
 /// The accepted backward error of `options` (1e-10 when unset).

@@ -1,4 +1,5 @@
-//! Errors of reading model files, with file and line.
+//! Errors of reading model files, with file and line (below `error`, which wraps them, and
+//! `io`, which makes them).
 
 /// A model file could not be read or parsed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
