@@ -1147,7 +1147,7 @@ fn solve_matrix(
 
 fn export_matrix(model_path: &Path, out: &Path) -> Result<(), Error> {
     let model = io::load_model(model_path)?;
-    let job = fibercell::solve::job_system(&model)?;
+    let job = io::job_system(&model)?;
     io::write_job_system(&job, model_path, out).map(|_| ())
 }
 

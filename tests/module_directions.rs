@@ -1,7 +1,9 @@
 //! The lower modules of the root crate do not reach up: `constraints` uses no solver,
-//! `generate` no file format or homogenization, the errors no file reader, `model` nothing
-//! (before, `constraints` called `solve::locate`, `error` took `InputError` from `io`, and the
-//! fixture catalog in `generate` read files and homogenized).
+//! `generate` no file format or homogenization, `solve` no homogenization or file format, the
+//! errors no file reader, `model` nothing
+//! (before, `constraints` called `solve::locate`, `error` took `InputError` from `io`, the
+//! fixture catalog in `generate` read files and homogenized, and `solve::job_system` built the
+//! cell problems of `homogenize`).
 
 use std::path::{Path, PathBuf};
 
@@ -29,6 +31,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
         &["solve", "homogenize", "io", "generate", "bench"],
     ),
     ("generate", &["io", "homogenize", "solve", "bench"]),
+    ("solve", &["homogenize", "io", "generate", "bench"]),
 ];
 
 /// The `.rs` files of module `name` (a file or a folder of `src`).

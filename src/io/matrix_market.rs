@@ -48,12 +48,12 @@ pub fn write_matrix_market(a: CscRef<'_>, comment: &str) -> String {
     s
 }
 
-/// Writes `job` ([`crate::solve::job_system`] of the model at `source`) to `out` (Matrix
+/// Writes `job` ([`super::job_system`] of the model at `source`) to `out` (Matrix
 /// Market, symmetric, lower triangle), its right-hand sides to `OUT_rhs.mtx` and the node and
 /// DOF of every row to `OUT_dofs.csv`, each file atomically; the header of both matrices says
 /// which problem it is and where the rows are described. Returns the three paths.
 pub fn write_job_system(
-    job: &crate::solve::JobSystem,
+    job: &super::JobSystem,
     source: &Path,
     out: &Path,
 ) -> Result<[PathBuf; 3], Error> {

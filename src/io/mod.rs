@@ -8,6 +8,7 @@ mod atomic;
 mod catalog;
 mod curve_files;
 mod inp_number;
+mod job_system;
 mod matrix_market;
 mod native;
 mod plot;
@@ -24,6 +25,7 @@ pub use curve_files::{
     RESULTANT_UNITS, STRAIN_UNITS,
 };
 pub use inp_number::{inp_number, MAX_FIELD};
+pub use job_system::{job_system, JobSystem};
 pub use matrix_market::{write_job_system, write_matrix_market, write_matrix_market_dense};
 pub use native::{parse_json, parse_toml, parse_toml_as, to_json, to_toml};
 pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};

@@ -6,7 +6,6 @@ mod connectivity;
 mod gram;
 mod increment_timings;
 mod incremental;
-mod job_system;
 mod kept_contact_loads;
 mod low_rank;
 mod matrix_solve;
@@ -23,7 +22,6 @@ pub use incremental::{
     EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS,
     MAX_LOW_RANK_COLUMNS,
 };
-pub use job_system::{job_system, JobSystem};
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
 pub use matrix_solve::{
     solve_matrix, MatrixSolveReport, MatrixSolver, MATRIX_SOLVE_BACKWARD_ERROR,

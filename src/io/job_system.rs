@@ -1,8 +1,8 @@
 //! The linear system a model's job solves, for other tools (`fibercell export-matrix`): a
 //! cell's six elastic cell problems, or a supported model's reduced K u = F.
 
-use super::ReducedSystem;
 use crate::homogenize::{cell_problem, LinearSystem};
+use crate::solve::ReducedSystem;
 use crate::{Error, Model};
 
 /// The system of a model's job and what it is.
