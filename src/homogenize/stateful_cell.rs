@@ -104,13 +104,14 @@ impl Cell {
     /// macroscopic strain) with the stick/slip settings `options` (`steps`, `path` and
     /// `deadline` are not used: each update is one increment, halved where needed).
     pub fn new(model: &Model, options: &IncrementalOptions) -> Result<Self, Error> {
+        // The cell first (a model without [cell] is told so, not asked to drop its loads).
+        let (periodicity, set, anchor) = super::system::prepare_cell(model, true)?;
         if !model.loads.is_empty() {
             return Err(Error::InvalidOption(
                 "a stateful cell is driven by its macroscopic strain alone: remove its [[loads]]"
                     .into(),
             ));
         }
-        let (periodicity, set, anchor) = super::system::prepare_cell(model, true)?;
         let disc = Discretization::periodic(model, &periodicity, &[0.0; 6], anchor);
         let options = IncrementalOptions {
             steps: 1,
