@@ -66,6 +66,16 @@ pub trait LinearSolver: Send {
     fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError>;
     /// Solves A X = B in place; `rhs` holds `nrhs` columns of length n, column after column.
     fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError>;
+    /// Another solver on this one's analysis and current factorization, read-only, with
+    /// workspaces of its own: its solves give what this one's give, bit for bit, and several
+    /// may solve at once on different threads (many material points on one reference
+    /// factorization). A `factorize` on it (or on this one) makes that solver's own numeric
+    /// factor and leaves the other's as it was; `analyze` makes its own analysis. `None`
+    /// (the default) where a backend cannot share its factors: the caller factorizes its own.
+    fn share(&self) -> Option<Box<dyn LinearSolver>> {
+        None
+    }
+
     /// Turns the current factorization of A into one of A + W Wᵀ (`update`) or A − W Wᵀ
     /// (downdate) without refactorizing, W an n × k matrix (e.g. the square roots of k contact
     /// springs switched on or off); later solves use it until the next `factorize`. Backends

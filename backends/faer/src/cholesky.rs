@@ -24,6 +24,7 @@ use fibercell_solver::{
     compute_ordering, AnalyzeInfo, Capabilities, CscRef, ForwardColumns, LinearSolver,
     LowerTriangle, Ordering, PatternFingerprint, Permutation, SolveInfo, SolverError,
 };
+use std::sync::Arc;
 
 /// LLᵀ or LDLᵀ (no square roots; same sparsity).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -42,8 +43,12 @@ pub struct FaerCholesky {
     ordering: Ordering,
     pivot_tolerance: f64,
     par: Par,
-    analysis: Option<Analysis>,
-    factor: Option<Factor>,
+    /// Shared with the solvers [`LinearSolver::share`] made (read-only).
+    analysis: Option<Arc<Analysis>>,
+    /// Shared likewise; a `factorize` reuses it only while no other solver holds it.
+    factor: Option<Arc<Factor>>,
+    /// Workspace of the numeric factorization, sized once per analysis.
+    scratch: Option<MemBuffer>,
     /// One right-hand side in the factor's order, kept between solves.
     work: Vec<f64>,
 }
@@ -67,8 +72,6 @@ struct Analysis {
 
 struct Factor {
     l_values: Vec<f64>,
-    /// Workspace of the numeric factorization, sized once per analysis.
-    scratch: MemBuffer,
     scale: Vec<f64>,
     lower_values: Vec<f64>,
 }
@@ -100,6 +103,7 @@ impl FaerCholesky {
             par: Par::rayon(0),
             analysis: None,
             factor: None,
+            scratch: None,
             work: Vec::new(),
         }
     }
@@ -211,6 +215,7 @@ impl LinearSolver for FaerCholesky {
         <dyn LinearSolver>::check_symmetric_matrix(a)?;
         self.factor = None;
         self.analysis = None;
+        self.scratch = None;
         let n = a.ncols();
         let lower_tri = LowerTriangle::of(a);
         let lower = SymbolicSparseColMatRef::new_checked(
@@ -260,7 +265,7 @@ impl LinearSolver for FaerCholesky {
             Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
             None => ((0..n).collect(), (0..n).collect()),
         };
-        self.analysis = Some(Analysis {
+        self.analysis = Some(Arc::new(Analysis {
             n,
             fingerprint: a.fingerprint(),
             lower: lower_tri,
@@ -270,7 +275,7 @@ impl LinearSolver for FaerCholesky {
             factor_fwd,
             factor_inv,
             symbolic,
-        });
+        }));
         Ok(info)
     }
 
@@ -284,10 +289,18 @@ impl LinearSolver for FaerCholesky {
             return Err(SolverError::PatternChanged);
         }
         let n = an.n;
-        // Reuse the buffers of the previous factorization when there is one.
-        let mut f = match self.factor.take() {
+        // Reuse the buffers of the previous factorization when no shared solver holds them.
+        let mut f = match self.factor.take().and_then(|f| Arc::try_unwrap(f).ok()) {
             Some(f) => f,
-            None => {
+            None => Factor {
+                l_values: vec![0.0; an.symbolic.len_val()],
+                scale: vec![0.0; n],
+                lower_values: vec![0.0; an.lower.nnz()],
+            },
+        };
+        let scratch = match &mut self.scratch {
+            Some(buffer) => buffer,
+            empty => {
                 let req = match self.variant {
                     CholeskyVariant::Llt => an
                         .symbolic
@@ -296,12 +309,7 @@ impl LinearSolver for FaerCholesky {
                         .symbolic
                         .factorize_numeric_ldlt_scratch::<f64>(self.par, Spec::default()),
                 };
-                Factor {
-                    l_values: vec![0.0; an.symbolic.len_val()],
-                    scratch: MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?,
-                    scale: vec![0.0; n],
-                    lower_values: vec![0.0; an.lower.nnz()],
-                }
+                empty.insert(MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?)
             }
         };
         an.lower
@@ -327,7 +335,7 @@ impl LinearSolver for FaerCholesky {
                     Side::Lower,
                     LltRegularization::default(),
                     self.par,
-                    MemStack::new(&mut f.scratch),
+                    MemStack::new(scratch),
                     Spec::default(),
                 );
                 if let Err(LltError::NonPositivePivot { index }) = r {
@@ -341,7 +349,7 @@ impl LinearSolver for FaerCholesky {
                     Side::Lower,
                     LdltRegularization::default(),
                     self.par,
-                    MemStack::new(&mut f.scratch),
+                    MemStack::new(scratch),
                     Spec::default(),
                 );
                 if let Err(e) = r {
@@ -361,8 +369,21 @@ impl LinearSolver for FaerCholesky {
                 return Err(pivot_error(an.perm.fwd[k], pivot));
             }
         }
-        self.factor = Some(f);
+        self.factor = Some(Arc::new(f));
         Ok(())
+    }
+
+    fn share(&self) -> Option<Box<dyn LinearSolver>> {
+        Some(Box::new(FaerCholesky {
+            variant: self.variant,
+            ordering: self.ordering.clone(),
+            pivot_tolerance: self.pivot_tolerance,
+            par: self.par,
+            analysis: self.analysis.clone(),
+            factor: self.factor.clone(),
+            scratch: None,
+            work: Vec::new(),
+        }))
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64], nrhs: usize) -> Result<SolveInfo, SolverError> {
@@ -468,5 +489,75 @@ impl LinearSolver for FaerCholesky {
             an.tree
                 .forward(&factor, columns, &an.schedule, par, Some(y))
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_matrices::{grid, grid_factor};
+
+    /// The solution of `solver` for `b`, one right-hand side.
+    fn solved(solver: &mut dyn LinearSolver, b: &[f64]) -> Vec<f64> {
+        let mut x = b.to_vec();
+        solver.solve_in_place(&mut x, 1).unwrap();
+        x
+    }
+
+    /// A shared solver solves bit for bit as its origin (one and several right-hand sides,
+    /// the two halves, sparse forward columns), from two threads at once; a factorization of
+    /// other values on either side leaves the other's factor as it was.
+    #[test]
+    fn shared_solvers_solve_alike_and_factorize_apart() {
+        let (n, a, mut origin) = grid_factor(12);
+        let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 23) as f64 - 11.0).collect();
+        let expected = solved(&mut origin, &b);
+        let mut shared = origin.share().expect("faer Cholesky shares");
+        assert_eq!(solved(shared.as_mut(), &b), expected);
+        let mut two = [b.clone(), b.clone()].concat();
+        shared.solve_in_place(&mut two, 2).unwrap();
+        let mut two_origin = [b.clone(), b.clone()].concat();
+        origin.solve_in_place(&mut two_origin, 2).unwrap();
+        assert_eq!(two, two_origin);
+        let (mut lower, mut lower_origin) = (b.clone(), b.clone());
+        shared.solve_lower_in_place(&mut lower).unwrap();
+        origin.solve_lower_in_place(&mut lower_origin).unwrap();
+        assert_eq!(lower, lower_origin);
+        let columns = vec![vec![(3, 1.0), (40, -2.0)], vec![(n - 1, 0.5)]];
+        let (w, w_origin) = (
+            shared.forward_solve_sparse(&columns).unwrap(),
+            origin.forward_solve_sparse(&columns).unwrap(),
+        );
+        assert_eq!(w.gram(), w_origin.gram());
+        // Two threads solving on one factor at once.
+        let mut other = origin.share().expect("shares");
+        let (x1, x2) = rayon::join(
+            || solved(shared.as_mut(), &b),
+            || solved(other.as_mut(), &b),
+        );
+        assert_eq!((&x1, &x2), (&expected, &expected));
+        // Doubled values on the shared side: its solution halves, the origin's stays.
+        let mut doubled = a.clone();
+        doubled.values_mut().iter_mut().for_each(|v| *v *= 2.0);
+        shared.factorize(doubled.as_ref()).unwrap();
+        let half = solved(shared.as_mut(), &b);
+        let big = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(half
+            .iter()
+            .zip(&expected)
+            .all(|(h, e)| (2.0 * h - e).abs() <= 1e-12 * big));
+        assert_eq!(solved(&mut origin, &b), expected);
+        // And the origin refactorized with other values: the other shared solver keeps the old.
+        origin.factorize(doubled.as_ref()).unwrap();
+        assert_eq!(solved(other.as_mut(), &b), expected);
+        // A share of an analysis without a factor factorizes on the shared analysis.
+        let mut analyzed = FaerCholesky::default();
+        analyzed.analyze(grid(12).as_ref()).unwrap();
+        let mut late = analyzed.share().expect("shares");
+        late.factorize(a.as_ref()).unwrap();
+        assert!(solved(late.as_mut(), &b)
+            .iter()
+            .zip(&expected)
+            .all(|(x, e)| (x - e).abs() <= 1e-12 * big));
     }
 }
