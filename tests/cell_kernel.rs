@@ -301,3 +301,35 @@ fn a_state_without_caches_continues_like_one_with_them() {
     let c = cell.update(&mut released, &e11(1e-3)).expect("update");
     assert!(c.resultant[0] > b.resultant[0]);
 }
+
+/// The cell's factorization at rest is every state's: a state's first update makes none of
+/// its own, and a state without caches past rest (a clone) continues on it, its sliding
+/// contacts a low-rank correction, like the original to the solver's tolerances. (A bound
+/// on the capacitance order makes the choice between correcting and factorizing independent
+/// of the machine's timings.) Without the sharing each of them factorizes once.
+#[test]
+fn states_solve_on_the_cells_factorization_at_rest() {
+    let first = cell()
+        .update(&mut cell().new_state(), &e11(1e-4))
+        .expect("update");
+    assert_eq!(first.factorizations, 0);
+    let options = IncrementalOptions {
+        max_capacitance_order: Some(100_000),
+        ..IncrementalOptions::default()
+    };
+    let cell = Cell::new(&fixture(), &options)
+        .expect("cell")
+        .without_tangent();
+    let mut original = cell.new_state();
+    for _ in 0..4 {
+        cell.update(&mut original, &e11(1e-3)).expect("update");
+    }
+    let mut copy = original.clone();
+    let a = cell.update(&mut original, &e11(1e-3)).expect("update");
+    let b = cell.update(&mut copy, &e11(1e-3)).expect("update");
+    assert!(b.slip > 0, "the copy's contacts slide");
+    assert_eq!(b.factorizations, 0);
+    let d = (a.resultant[0] - b.resultant[0]).abs();
+    assert!(d <= 1e-7 * a.resultant[0].abs(), "{d:e}");
+    assert_eq!((a.slip, a.stick), (b.slip, b.stick));
+}

@@ -6,9 +6,9 @@
 //!
 //! A state follows a straight strain path E(α) = E₀ + α D: an increment along the path's
 //! direction continues it (the solver's predictors and reference loads stay valid), any
-//! other one starts a new path at the current strain. A state owns its factorizations (the
-//! cell's pattern and elastic values are shared): states are independent and may be updated
-//! in parallel.
+//! other one starts a new path at the current strain. The cell's factorization at rest is
+//! shared by all states (read-only); what a state factorizes later is its own: states are
+//! independent and may be updated in parallel.
 
 use super::curve::check_small_strain;
 use super::elastic::homogenize_elastic;
@@ -33,8 +33,8 @@ pub struct Cell {
 /// its strain path, and its own factorizations.
 ///
 /// `clone` copies the committed state without the factorizations: the copy's next update
-/// factorizes anew, and its results equal the original's to the solver's tolerances (not
-/// bit for bit).
+/// solves on the cell's factorization at rest (or factorizes anew), and its results equal the
+/// original's to the solver's tolerances (not bit for bit).
 #[derive(Clone)]
 pub struct CellState {
     run: RunState,
@@ -55,10 +55,10 @@ impl CellState {
         self.run.step
     }
 
-    /// Drops the state's factorizations and matrix values until its next update, which then
-    /// factorizes anew (and analyzes the pattern again): for many material points, whose
-    /// caches would not fit in memory together (on the S non-woven 67 MB a state with them,
-    /// 5.4 MB without). The committed state is unchanged.
+    /// Drops the state's factorizations, low-rank columns and matrix values until its next
+    /// update, which then solves on the cell's factorization at rest (or factorizes anew):
+    /// for many material points whose caches would not fit in memory together. The committed
+    /// state is unchanged.
     pub fn release_caches(&mut self) {
         self.run.release_caches();
     }
@@ -85,6 +85,10 @@ pub struct CellResponse {
     pub iterations: usize,
     /// Times the increment was halved.
     pub cutbacks: usize,
+    /// Factorizations the state made itself in the increment: none where it solved on the
+    /// cell's shared factorization at rest (see [`Cell::new`]) or on its own earlier one,
+    /// corrected by the contacts changed since (a consistent tangent's own is not counted).
+    pub factorizations: usize,
     /// Contacts held in their state after chattering.
     pub held: usize,
     /// The increment's equilibrium residual (see [`crate::solve::IncrementRecord::equilibrium_residual`]).
@@ -103,6 +107,12 @@ impl Cell {
     /// Sets up the periodic cell `model` (no supports, no nodal loads: it is driven by its
     /// macroscopic strain) with the stick/slip settings `options` (`steps`, `path` and
     /// `deadline` are not used: each update is one increment, halved where needed).
+    ///
+    /// With a backend that can share a factorization (faer Cholesky, the default), the
+    /// all-stick matrix at rest is analyzed and factorized here, once, for every state: a
+    /// state at rest solves on it (bit for bit as if it had factorized it), and a state without
+    /// caches (cloned, released) solves on it with its contacts changed since rest as a
+    /// low-rank correction while that is cheaper than factorizing its own.
     pub fn new(model: &Model, options: &IncrementalOptions) -> Result<Self, Error> {
         // The cell first (a model without [cell] is told so, not asked to drop its loads).
         let (periodicity, set, anchor) = super::system::prepare_cell(model, true)?;
@@ -120,12 +130,13 @@ impl Cell {
             progress: None,
             ..options.clone()
         };
-        let setup = Setup::new(
+        let mut setup = Setup::new(
             Cow::Owned(model.clone()),
             Cow::Owned(disc),
             set,
             Cow::Owned(options),
         )?;
+        setup.share_rest_factorization()?;
         Ok(Cell {
             area: periodicity.geometry.area(),
             setup,
@@ -240,6 +251,7 @@ impl Cell {
             slip: r.slip,
             iterations: r.iterations,
             cutbacks: r.cutbacks,
+            factorizations: r.factorizations,
             held: r.held,
             equilibrium_residual: r.equilibrium_residual,
             energy_error: r.energy.relative_error,

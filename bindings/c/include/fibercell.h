@@ -69,6 +69,8 @@ typedef struct FcCellResponse {
   uintptr_t iterations;
   // Times the increment was halved.
   uintptr_t cutbacks;
+  // Factorizations the state made itself (none on the cell's shared one at rest).
+  uintptr_t factorizations;
   // Contacts held in their state after chattering.
   uintptr_t held;
   // The increment's equilibrium residual ‖R‖/‖F‖.

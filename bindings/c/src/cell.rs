@@ -50,6 +50,8 @@ pub struct FcCellResponse {
     pub iterations: usize,
     /// Times the increment was halved.
     pub cutbacks: usize,
+    /// Factorizations the state made itself (none on the cell's shared one at rest).
+    pub factorizations: usize,
     /// Contacts held in their state after chattering.
     pub held: usize,
     /// The increment's equilibrium residual ‖R‖/‖F‖.
@@ -78,6 +80,7 @@ impl From<&CellResponse> for FcCellResponse {
             slip: r.slip,
             iterations: r.iterations,
             cutbacks: r.cutbacks,
+            factorizations: r.factorizations,
             held: r.held,
             equilibrium_residual: r.equilibrium_residual,
             energy_error: r.energy_error,

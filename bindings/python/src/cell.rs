@@ -180,6 +180,7 @@ fn response<'py>(py: Python<'py>, r: &CellResponse) -> PyResult<Bound<'py, PyDic
     d.set_item("slip", r.slip)?;
     d.set_item("iterations", r.iterations)?;
     d.set_item("cutbacks", r.cutbacks)?;
+    d.set_item("factorizations", r.factorizations)?;
     d.set_item("held", r.held)?;
     d.set_item("equilibrium_residual", r.equilibrium_residual)?;
     d.set_item("energy_error", r.energy_error)?;

@@ -186,7 +186,8 @@ def test_cell_updates_are_the_cli_curve():
 
 def test_cell_trial_copy_threads_and_errors():
     """On the grid cell (linear, A11 = E A / Ly): N11 = A11 ε11 and the tangent's A11 to 1e-9;
-    a trial commits nothing; a copy continues like the original; states updated from two
+    a trial commits nothing; a copy continues like the original, all on the cell's
+    factorization at rest; states updated from two
     threads at once equal serial ones; bad increments and foreign states raise."""
     grid = fibercell.Model.load("fixtures/ok_cell_grid.toml")
     cell = fibercell.Cell(grid)
@@ -203,6 +204,8 @@ def test_cell_trial_copy_threads_and_errors():
     b = cell.update(copy, {"e22": 1e-3})
     assert abs(a["resultant"][1] / t["resultant"][1] - 1) <= 1e-12
     assert abs(b["resultant"][1] / a["resultant"][1] - 1) <= 1e-12
+    # All of them on the cell's factorization at rest: none of their own.
+    assert (r["factorizations"], a["factorizations"], b["factorizations"]) == (0, 0, 0)
 
     states = [cell.new_state() for _ in range(2)]
     steps = [{"e11": 1e-3}, {"g12": 1e-3}]

@@ -49,6 +49,7 @@ impl StickSlip<'_, '_, '_> {
         if changes.is_none() {
             matrix.changed_since_reference = None;
             matrix.values.copy_from_slice(&setup.k_elastic);
+            assembled_values(setup, contacts, &mut matrix.values);
         }
         let mut rhs = path.rhs(inc.alpha);
         let scatter = Scatter {
@@ -58,15 +59,7 @@ impl StickSlip<'_, '_, '_> {
             alpha: inc.alpha,
         };
         if changes.is_none() {
-            // The contact blocks and loads for the current states.
-            setup.contact_columns.add(
-                &setup.pairs,
-                &setup.pattern,
-                &setup.disc,
-                &mut matrix.values,
-                None,
-                |i| contact_block(setup, contacts, i),
-            );
+            // The contact loads for the current states.
             scatter.by_colors(&|i| Some(contacts.states[i]), &mut rhs);
         } else {
             scatter.loads(inc, kept_loads, &mut rhs);
@@ -91,6 +84,18 @@ impl StickSlip<'_, '_, '_> {
             nonsymmetric,
         })
     }
+}
+
+/// Adds every contact's block in its current state to the element values `values`.
+pub(super) fn assembled_values(setup: &Setup<'_>, contacts: &ContactStates, values: &mut [f64]) {
+    setup.contact_columns.add(
+        &setup.pairs,
+        &setup.pattern,
+        &setup.disc,
+        values,
+        None,
+        |i| contact_block(setup, contacts, i),
+    );
 }
 
 /// Contact i's block in its current state (see [`ContactPair::block_coefficients`]).

@@ -13,6 +13,7 @@ use crate::solve::low_rank::Reference;
 use crate::solve::{SolverConfig, SolverKind};
 use crate::Error;
 use fibercell_solver::{solve_checked, SolveReport, SolverError};
+use std::sync::Arc;
 
 impl StickSlip<'_, '_, '_> {
     /// Factorizes `system` if needed and solves it: the solution and its report (none without
@@ -54,6 +55,10 @@ impl StickSlip<'_, '_, '_> {
         } else {
             (&mut backends.symmetric, setup.opts.solve.solver)
         };
+        if slot.is_none() && !nonsymmetric {
+            // The cell's shared analysis, when there is one.
+            *slot = setup.shared.as_ref().and_then(|s| s.solver());
+        }
         if slot.is_none() {
             let mut s = SolverConfig {
                 kind,
@@ -80,10 +85,23 @@ impl StickSlip<'_, '_, '_> {
         let mut refactorized = false;
         if make_reference || factors.factorized.as_ref() != Some(&key) {
             let started = std::time::Instant::now();
-            solver.factorize(a).map_err(locate)?;
-            inc.factorizations += 1;
-            if !nonsymmetric {
-                factors.cost.factorize = Some(started.elapsed().as_secs_f64());
+            // A reference at rest is the cell's shared factorization (the same values).
+            let shared = setup
+                .shared
+                .as_ref()
+                .filter(|s| make_reference && s.is_of(&matrix.values));
+            match shared.and_then(|s| Some((s.solver()?, s.factorize_seconds()))) {
+                Some((rest, seconds)) => {
+                    *solver = rest;
+                    factors.cost.factorize = Some(seconds);
+                }
+                None => {
+                    solver.factorize(a).map_err(locate)?;
+                    inc.factorizations += 1;
+                    if !nonsymmetric {
+                        factors.cost.factorize = Some(started.elapsed().as_secs_f64());
+                    }
+                }
             }
             if !make_reference {
                 factors.factorized = Some(key);
@@ -91,7 +109,10 @@ impl StickSlip<'_, '_, '_> {
                 factors.refresh_reference = false;
                 factors.reference = Some(reference_blocks(setup, contacts));
                 refactorized = true;
-                matrix.reference.copy_from_slice(&matrix.values);
+                matrix.reference = match shared {
+                    Some(s) => s.values(),
+                    None => Arc::new(matrix.values.clone()),
+                };
                 matrix.changed_since_reference = Some(Vec::new());
                 factors.low_rank.reset();
                 factors.affine.clear();
@@ -126,7 +147,7 @@ impl StickSlip<'_, '_, '_> {
 }
 
 /// Every contact's block as the reference factorization has it.
-fn reference_blocks(
+pub(super) fn reference_blocks(
     setup: &super::setup::Setup<'_>,
     contacts: &ContactStates,
 ) -> Vec<ReferenceBlock> {

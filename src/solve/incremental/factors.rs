@@ -60,6 +60,7 @@ impl LowRankCost {
 
 /// A contact as the reference factorization has it: block coefficients, what they and the
 /// load were computed from, and the anchor of the k⊥ spring.
+#[derive(Clone)]
 pub(super) struct ReferenceBlock {
     pub stiffness: BlockCoefficients,
     pub state: BlockState,

@@ -4,24 +4,25 @@
 use super::super::ContactChange;
 use crate::assembly::{add_contact_block, Pattern, NO_SLOT};
 use crate::contact::ContactPair;
+use std::sync::Arc;
 
 /// The matrix values of the current state iteration and of the reference factorization A₀.
 pub(super) struct MatrixValues {
     /// The current matrix's values in the pattern's slots.
     pub values: Vec<f64>,
-    /// A₀'s values.
-    pub reference: Vec<f64>,
+    /// A₀'s values (shared with the cell's factorization at rest when that is A₀).
+    pub reference: Arc<Vec<f64>>,
     /// When `values` is `reference` plus the blocks of these contacts only: restoring their
     /// slots is enough to start the next iteration from the reference.
     pub changed_since_reference: Option<Vec<usize>>,
 }
 
 impl MatrixValues {
-    /// The elastic values `k_elastic` and no reference yet.
+    /// The elastic values `k_elastic` and no reference yet (an empty one).
     pub fn new(k_elastic: &[f64]) -> Self {
         MatrixValues {
             values: k_elastic.to_vec(),
-            reference: vec![0.0; k_elastic.len()],
+            reference: Arc::default(),
             changed_since_reference: None,
         }
     }
@@ -50,7 +51,7 @@ impl MatrixValues {
                     }
                 }
             }
-            None => self.values.copy_from_slice(&self.reference),
+            None => self.values.copy_from_slice(&self.reference[..]),
         }
         self.changed_since_reference = Some(changes.iter().map(|ch| ch.contact).collect());
         for ch in changes {

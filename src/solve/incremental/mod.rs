@@ -43,6 +43,7 @@ mod records;
 mod return_mapping;
 mod run_state;
 mod setup;
+mod shared_reference;
 mod stabilizer;
 
 pub use driver_couplings::DriverCouplings;

@@ -171,10 +171,17 @@ impl<'s, 'a> StickSlip<'s, 'a, '_> {
             energy,
             out,
             path,
+            step,
             ..
         } = run;
+        let mut factors = factors;
         if matrix.values.len() != setup.k_elastic.len() {
             matrix = MatrixValues::new(&setup.k_elastic);
+        }
+        // A state past rest without caches solves on the cell's rest factorization (a state
+        // at rest meets it in its first factorization, bit for bit as a run).
+        if let (None, true, Some(shared)) = (&factors.reference, step > 0, &setup.shared) {
+            shared.adopt(&mut factors, &mut matrix);
         }
         StickSlip {
             setup,

@@ -4,6 +4,7 @@
 
 use super::options::SLIP_DIRECTION_TOLERANCE;
 use super::return_mapping::Law;
+use super::shared_reference::SharedReference;
 use super::IncrementalOptions;
 use crate::assembly::{color_blocks, ContactColumns, ElementBlocks, Pattern};
 use crate::constraints::Discretization;
@@ -58,6 +59,8 @@ pub(crate) struct Setup<'a> {
     /// See [`SLIP_DIRECTION_TOLERANCE`].
     pub direction_tol: f64,
     pub stabilization: f64,
+    /// A cell's factorization at rest, shared by its states (none in a single run).
+    pub(super) shared: Option<SharedReference>,
 }
 
 impl<'a> Setup<'a> {
@@ -152,7 +155,15 @@ impl<'a> Setup<'a> {
             length_tol,
             direction_tol,
             stabilization,
+            shared: None,
         })
+    }
+
+    /// Factorizes the rest state once for every state run on this setup to share (see
+    /// [`SharedReference`]).
+    pub fn share_rest_factorization(&mut self) -> Result<(), Error> {
+        self.shared = SharedReference::build(self)?;
+        Ok(())
     }
 
     /// The run's friction law.

@@ -97,8 +97,9 @@ static void the_solver_layer_solves_a_known_system(void) {
 }
 
 /* The stateful cell on the grid cell (no contacts: linear): N11 = A11 ε11 and dN11/dε11 = A11,
- * A11 = E A / Ly; a trial commits nothing; a copy continues like the original; a state of
- * another cell and a NaN increment are refused, leaving the state as it was. */
+ * A11 = E A / Ly, solved on the cell's factorization at rest; a trial commits nothing; a copy
+ * continues like the original; a state of another cell and a NaN increment are refused, leaving
+ * the state as it was. */
 static void the_stateful_cell_updates_and_tries(void) {
     FcModel *grid = NULL;
     CHECK(fc_model_load("fixtures/ok_cell_grid.toml", &grid) == FC_OK, "load");
@@ -114,6 +115,8 @@ static void the_stateful_cell_updates_and_tries(void) {
     for (int k = 1; k <= 2; k++) {
         CHECK(fc_cell_update(cell, state, de, &r) == FC_OK, "update %d", k);
         CHECK(fabs(r.resultant[0] / (a11 * k * 1e-3) - 1.0) <= 1e-9, "N11 %.17g", r.resultant[0]);
+        /* Both on the cell's factorization at rest, none of the state's own. */
+        CHECK(r.factorizations == 0, "update %d factorized %zu times", k, (size_t)r.factorizations);
     }
     CHECK(r.has_tangent && fabs(r.tangent[0] / a11 - 1.0) <= 1e-9, "dN11/de11 %.17g",
           r.tangent[0]);

@@ -132,8 +132,10 @@ class Cell:
     committing. A response is a dict: ``strain`` and ``resultant`` (6; N/m and N), ``tangent``
     (6 × 6 consistent dN/dE, None with ``tangent=False``), ``dissipated`` and
     ``stored_energy`` (J/m²), the contact counts ``open``, ``stick``, ``slip``, and the
-    increment's ``iterations``, ``cutbacks``, ``held``, ``equilibrium_residual`` and
-    ``energy_error``. Different states may be updated from different threads at once.
+    increment's ``iterations``, ``cutbacks``, ``factorizations`` (the state's own: none on
+    the cell's factorization at rest, which all states share), ``held``,
+    ``equilibrium_residual`` and ``energy_error``. Different states may be updated from
+    different threads at once.
 
     >>> import fibercell
     >>> grid = fibercell.Model.load("fixtures/ok_cell_grid.toml")
