@@ -40,6 +40,12 @@ impl Clone for ElementBlocks {
 /// Largest memory the element matrices are kept in.
 const ELEMENT_CACHE_BYTES: usize = 512 << 20;
 
+/// Elements a thread takes at least in [`ElementBlocks::internal_with_scale`]: a product with
+/// a 12 × 12 block takes tens of nanoseconds, handing work to another thread microseconds,
+/// so a cell of fewer elements runs on the calling thread alone (a small cell's update was
+/// mostly thread wake-ups).
+const ELEMENTS_PER_THREAD: usize = 1024;
+
 impl ElementBlocks {
     /// The blocks of `model`'s elements on `disc`.
     pub fn new(model: &Model, disc: &Discretization) -> Self {
@@ -263,20 +269,22 @@ impl ElementBlocks {
         match self.cached(model) {
             // One slice of the elements per thread, each into its own vector, summed.
             Some(all) => {
-                let chunk = all.len().div_ceil(rayon::current_num_threads()).max(1);
-                let parts: Vec<(Vec<f64>, f64)> = all
-                    .par_chunks(chunk)
-                    .enumerate()
-                    .map(|(p, ks)| {
-                        let (mut out, mut y) = (vec![0.0; q.len()], Vec::new());
-                        let squares = ks
-                            .iter()
-                            .enumerate()
-                            .map(|(i, k)| add(&mut out, &mut y, p * chunk + i, k))
-                            .sum::<f64>();
-                        (out, squares)
-                    })
-                    .collect();
+                let threads = rayon::current_num_threads().min(all.len() / ELEMENTS_PER_THREAD);
+                let chunk = all.len().div_ceil(threads.max(1)).max(1);
+                let part = |(p, ks): (usize, &[DMatrix<f64>])| {
+                    let (mut out, mut y) = (vec![0.0; q.len()], Vec::new());
+                    let squares = ks
+                        .iter()
+                        .enumerate()
+                        .map(|(i, k)| add(&mut out, &mut y, p * chunk + i, k))
+                        .sum::<f64>();
+                    (out, squares)
+                };
+                let parts: Vec<(Vec<f64>, f64)> = if threads > 1 {
+                    all.par_chunks(chunk).enumerate().map(part).collect()
+                } else {
+                    all.chunks(chunk).enumerate().map(part).collect()
+                };
                 let mut parts = parts.into_iter();
                 let (mut out, mut squares) =
                     parts.next().unwrap_or_else(|| (vec![0.0; q.len()], 0.0));

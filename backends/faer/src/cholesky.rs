@@ -190,6 +190,10 @@ impl FaerCholesky {
     }
 }
 
+/// Factor values × right-hand sides below which a solve stays on the calling thread (about
+/// 100 µs of work; waking another thread costs microseconds).
+const PARALLEL_SOLVE_VALUES: usize = 1 << 18;
+
 /// Threads of `par`.
 fn threads(par: Par) -> usize {
     match par {
@@ -412,11 +416,18 @@ impl LinearSolver for FaerCholesky {
             col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
         }
         // Several right-hand sides: column groups solved side by side, one per thread (faer's
-        // supernodal solve gains little from more columns at a time or from a parallel kernel).
-        let threads = threads(self.par);
+        // supernodal solve gains little from more columns at a time or from a parallel kernel);
+        // on the calling thread alone when the solves are too small to hand to another.
+        let threads = if f.l_values.len() * nrhs < PARALLEL_SOLVE_VALUES {
+            1
+        } else {
+            threads(self.par)
+        };
         let groups = threads.min(nrhs).max(1);
         let (par, per_group) = if groups > 1 {
             (Par::Seq, nrhs.div_ceil(groups))
+        } else if threads == 1 {
+            (Par::Seq, nrhs)
         } else {
             (self.par, nrhs)
         };
