@@ -76,6 +76,7 @@ use crate::model::Model;
 use crate::Error;
 use fibercell_solver::{CscRef, LinearSolver, SolveReport};
 use std::borrow::Cow;
+use std::sync::Arc;
 
 /// Runs the incremental stick/slip analysis of `model` (its supports, loads and contacts).
 pub fn solve_incremental(
@@ -216,7 +217,7 @@ impl<'s, 'a, 'h> StickSlip<'s, 'a, 'h> {
                 ..EnergyHistory::default()
             },
             out: IncrementalSolution {
-                contacts: setup.set.clone(),
+                contacts: Arc::clone(&setup.set),
                 increments: Vec::new(),
                 contact_results: Vec::new(),
                 displacements: Vec::new(),

@@ -4,6 +4,7 @@ use super::super::IncrementTimings;
 use crate::constraints::Reaction;
 use crate::contact::{ContactSet, ContactState};
 use serde::Serialize;
+use std::sync::Arc;
 
 /// One increment.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -136,8 +137,8 @@ fn state_name<S: serde::Serializer>(s: &ContactState, ser: S) -> Result<S::Ok, S
 /// Results of every increment.
 #[derive(Clone, Debug)]
 pub struct IncrementalSolution {
-    /// The contact pairs.
-    pub contacts: ContactSet,
+    /// The contact pairs (shared with the run's setup: a cell's states hold one copy).
+    pub contacts: Arc<ContactSet>,
     /// Per-increment summary.
     pub increments: Vec<IncrementRecord>,
     /// Per increment, every contact.

@@ -73,15 +73,8 @@ impl RunState {
         tangent: bool,
     ) -> Result<Advanced, Error> {
         let committed = self.without_caches();
-        let mut run = std::mem::replace(self, committed);
-        if let Some(direction) = turn {
-            run.turn(setup, direction);
-        }
-        let (from, step) = (run.alpha, run.step + 1);
-        let mut solver = StickSlip::resume(setup, run);
-        let advanced = solver.advance(step, (from, alpha), 0);
-        let mut done = solver.park(alpha, step);
-        let result = advanced.and_then(|()| done.advanced(setup, tangent));
+        let run = std::mem::replace(self, committed);
+        let (done, result) = run.taken(setup, turn, alpha, tangent);
         if result.is_ok() {
             *self = done;
         }
@@ -89,7 +82,7 @@ impl RunState {
     }
 
     /// The increment [`RunState::advance`] takes, not committed: the committed state stays,
-    /// with the caches the trial built.
+    /// with the caches the trial built (none after a failed one).
     pub fn trial(
         &mut self,
         setup: &Setup<'_>,
@@ -100,10 +93,33 @@ impl RunState {
         let mut run = self.without_caches();
         std::mem::swap(&mut run.factors, &mut self.factors);
         std::mem::swap(&mut run.matrix, &mut self.matrix);
-        let result = run.advance(setup, turn, alpha, tangent);
-        self.factors = run.factors;
-        self.matrix = run.matrix;
+        let (done, result) = run.taken(setup, turn, alpha, tangent);
+        // The caches of a failed trial are dropped, as a failed update drops them.
+        if result.is_ok() {
+            self.factors = done.factors;
+            self.matrix = done.matrix;
+        }
         result
+    }
+
+    /// This state after the increment to `alpha` (turned first to `turn`), and the increment's
+    /// outcome: the state is consumed, the caller keeps what it needs.
+    fn taken(
+        mut self,
+        setup: &Setup<'_>,
+        turn: Option<Vec<f64>>,
+        alpha: f64,
+        tangent: bool,
+    ) -> (Self, Result<Advanced, Error>) {
+        if let Some(direction) = turn {
+            self.turn(setup, direction);
+        }
+        let (from, step) = (self.alpha, self.step + 1);
+        let mut solver = StickSlip::resume(setup, self);
+        let advanced = solver.advance(step, (from, alpha), 0);
+        let mut done = solver.park(alpha, step);
+        let result = advanced.and_then(|()| done.advanced(setup, tangent));
+        (done, result)
     }
 
     /// The last increment's record (the others dropped) and, with `tangent`, the tangent.

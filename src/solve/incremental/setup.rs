@@ -15,6 +15,7 @@ use crate::Error;
 use fibercell_solver::SolverError;
 use nalgebra::{Vector2, Vector3};
 use std::borrow::Cow;
+use std::sync::Arc;
 
 /// Everything of a run that does not change with the increments: borrowed by a run, owned
 /// (`Setup<'static>`) by a [`crate::Cell`] whose states run on it.
@@ -23,7 +24,7 @@ pub(crate) struct Setup<'a> {
     pub disc: Cow<'a, Discretization>,
     pub opts: Cow<'a, IncrementalOptions>,
     /// The contacts as found (pairs on the model's nodes, origins).
-    pub set: ContactSet,
+    pub set: Arc<ContactSet>,
     /// Contact jumps on generalized nodes: B T.
     pub pairs: Vec<ContactPair>,
     pub(super) law: Law,
@@ -138,7 +139,7 @@ impl<'a> Setup<'a> {
             model,
             disc,
             opts,
-            set,
+            set: Arc::new(set),
             pairs,
             law: Law { friction, bonded },
             bound_fixed_point,
