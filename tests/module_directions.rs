@@ -1,7 +1,8 @@
 //! The lower modules of the root crate do not reach up: `constraints` uses no solver,
 //! `generate` no file format or homogenization, `solve` no homogenization or file format, the
-//! errors no file reader, `model` nothing
-//! (before, `constraints` called `solve::locate`, `error` took `InputError` from `io`, the
+//! errors no file reader and none of the modules whose errors they wrap, `model` nothing
+//! (before, `constraints` called `solve::locate`, `error` took `InputError` from `io` and
+//! `CellError` from `cell` (which used `error` back), the
 //! fixture catalog in `generate` read files and homogenized, and `solve::job_system` built the
 //! cell problems of `homogenize`).
 
@@ -25,7 +26,18 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
         "input_error",
         &["error", "io", "solve", "homogenize", "generate", "bench"],
     ),
-    ("error", &["io", "solve", "homogenize", "generate", "bench"]),
+    (
+        "error",
+        &[
+            "io",
+            "solve",
+            "homogenize",
+            "generate",
+            "bench",
+            "cell",
+            "assembly",
+        ],
+    ),
     (
         "constraints",
         &["solve", "homogenize", "io", "generate", "bench"],

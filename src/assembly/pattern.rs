@@ -3,6 +3,7 @@
 //! as the 24×24 contact blocks coupling four nodes (thesis 4.69–4.70) — to its place in the value
 //! array. Built once per set of blocks, so value fills never search or sort.
 
+pub use crate::error::PatternTooLargeError;
 use crate::model::Model;
 use fibercell_solver::{CscRef, SolverError};
 
@@ -23,11 +24,6 @@ pub struct Pattern {
     /// checks only sizes).
     checked: bool,
 }
-
-/// The pattern has more entries than the 32-bit slot map can address.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("the stiffness pattern has {0} entries, more than the 32-bit slot map holds")]
-pub struct PatternTooLargeError(pub usize);
 
 impl Pattern {
     /// The pattern of the frame elements of `model` over the numbering `reduced` of `n_free`

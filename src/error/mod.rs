@@ -1,4 +1,11 @@
-//! The crate-wide error type.
+//! The crate-wide error type, and the leaf error types of the modules below it (which
+//! re-export theirs), so that `error` uses none of the modules whose errors it wraps.
+
+mod cell_error;
+mod pattern_error;
+
+pub use cell_error::CellError;
+pub use pattern_error::PatternTooLargeError;
 
 use crate::input_error::InputError;
 use crate::model::{Dof, ModelError};
@@ -12,7 +19,7 @@ pub enum Error {
     Input(#[from] InputError),
     /// The periodic cell is invalid.
     #[error("invalid cell: {0}")]
-    Cell(#[from] crate::cell::CellError),
+    Cell(#[from] CellError),
     /// The model is invalid.
     #[error("invalid model: {0}")]
     Model(#[from] ModelError),
@@ -42,7 +49,7 @@ pub enum Error {
     Solver(#[from] SolverError),
     /// The stiffness pattern does not fit the 32-bit slot map.
     #[error(transparent)]
-    PatternTooLarge(#[from] crate::assembly::PatternTooLargeError),
+    PatternTooLarge(#[from] PatternTooLargeError),
     /// The state iteration of an increment settled only by holding contacts (that chattered, or
     /// still changed in its last iteration), and the held state is not in equilibrium: the
     /// cell has a mechanism there, or the increment is too large for the states to settle.
