@@ -2,6 +2,7 @@
 
 use crate::SolverError;
 use rayon::prelude::*;
+#[cfg(feature = "sprs")]
 use sprs::{CompressedStorage, CsMatView};
 
 /// A borrowed CSC matrix: `col_ptr` (len ncols + 1), `row_idx` and `values` (len nnz).
@@ -135,6 +136,7 @@ impl<'a> CscRef<'a> {
         })
     }
 
+    #[cfg(feature = "sprs")]
     /// Borrows an sprs matrix without copying. It must be stored CSC with a plain (unsliced)
     /// index pointer; use [`CscMatrix::from_sprs`] for any other sprs matrix.
     pub fn try_from_sprs(m: &'a CsMatView<'_, f64>) -> Result<Self, SolverError> {
@@ -412,6 +414,7 @@ impl CscMatrix {
         Self::from_triplets(a.nrows(), a.ncols(), &t)
     }
 
+    #[cfg(feature = "sprs")]
     /// Copies any sprs matrix (CSR or CSC, sliced or not) into CSC form.
     pub fn from_sprs(m: CsMatView<'_, f64>) -> Result<Self, SolverError> {
         let csc = if m.is_csc() { m.to_owned() } else { m.to_csc() };
@@ -449,6 +452,7 @@ impl CscMatrix {
         Ok(out)
     }
 
+    #[cfg(feature = "sprs")]
     /// Converts to an sprs CSC matrix (for tools that work with sprs).
     pub fn to_sprs(&self) -> sprs::CsMat<f64> {
         sprs::CsMat::new_csc(
@@ -531,6 +535,7 @@ mod tests {
         assert!(e.to_string().contains("out of range"), "{e}");
     }
 
+    #[cfg(feature = "sprs")]
     #[test]
     fn sprs_round_trip_csr_and_csc() {
         let a = CscMatrix::from_triplets(

@@ -1,20 +1,24 @@
 //! The sparse linear solver layer of fibercell, usable on its own.
 //!
 //! It knows nothing about fibers: it takes square sparse matrices in compressed sparse column
-//! (CSC) form — its own [`CscRef`] views or [`sprs`] matrices through [`CscMatrix::from_sprs`] /
-//! [`CscRef::try_from_sprs`] — and offers
+//! (CSC) form — its own [`CscRef`] views, or sprs matrices through `CscMatrix::from_sprs` /
+//! `CscRef::try_from_sprs` (feature `sprs`) — and offers
 //!
 //! * the [`LinearSolver`] trait with separate *analyze* (ordering + symbolic factorization, once
 //!   per sparsity pattern), *factorize* (numeric, whenever values change) and *solve* (any number of
 //!   right-hand sides) phases;
 //! * fill-reducing [`Ordering`]s: approximate minimum degree, nested dissection (METIS
-//!   `METIS_NodeND`), natural or a given permutation;
+//!   `METIS_NodeND`, feature `metis`), natural or a given permutation;
 //! * typed [`SolverError`]s and [`solve_checked`], which reports the relative residual
 //!   ‖Ax − b‖/‖b‖ of every solve and never returns a non-finite solution.
 //!
 //! Backends live in their own crates (`fibercell-faer`, `fibercell-cg`, `fibercell-cholmod`).
 //! Symmetric matrices are always passed with **both triangles stored**; Cholesky backends read
 //! the lower one.
+//!
+//! Features (both on by default): `metis` (nested dissection; without it that ordering is
+//! [`SolverError::Unavailable`] and a backend's automatic choice is AMD) and `sprs` (the
+//! conversions to and from sprs matrices).
 
 mod csc;
 mod error;

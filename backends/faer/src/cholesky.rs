@@ -243,8 +243,13 @@ impl LinearSolver for FaerCholesky {
                     || candidate(Ordering::Amd),
                     || candidate(Ordering::NestedDissection),
                 );
-                let (amd, nd) = (amd?, nd?);
-                if nd.2 < amd.2 {
+                // Without METIS (fibercell-solver's `metis` feature) AMD alone.
+                let nd = match nd {
+                    Err(SolverError::Unavailable { .. }) => None,
+                    nd => Some(nd?),
+                };
+                let amd = amd?;
+                if let Some(nd) = nd.filter(|nd| nd.2 < amd.2) {
                     (nd.0, nd.1, "auto→nested-dissection".to_string())
                 } else {
                     (amd.0, amd.1, "auto→amd".to_string())
