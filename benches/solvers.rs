@@ -4,7 +4,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use fibercell::solve::ReducedSystem;
-use fibercell::solver::{LinearSolver, Ordering};
+use fibercell::solver::{FillOrdering, LinearSolver};
 use fibercell_faer::{CholeskyVariant, FaerCholesky, FaerLu};
 use std::hint::black_box;
 use std::path::Path;
@@ -16,20 +16,20 @@ fn backends() -> Vec<(&'static str, Make)> {
     let mut v: Vec<(&'static str, Make)> = vec![
         (
             "faer-llt-amd",
-            Box::new(|| Box::new(FaerCholesky::new(CholeskyVariant::Llt, Ordering::Amd))),
+            Box::new(|| Box::new(FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::Amd))),
         ),
         (
             "faer-llt-nd",
             Box::new(|| {
                 Box::new(FaerCholesky::new(
                     CholeskyVariant::Llt,
-                    Ordering::NestedDissection,
+                    FillOrdering::NestedDissection,
                 ))
             }),
         ),
         (
             "faer-ldlt-amd",
-            Box::new(|| Box::new(FaerCholesky::new(CholeskyVariant::Ldlt, Ordering::Amd))),
+            Box::new(|| Box::new(FaerCholesky::new(CholeskyVariant::Ldlt, FillOrdering::Amd))),
         ),
         ("faer-lu", Box::new(|| Box::new(FaerLu::new()))),
     ];
@@ -37,15 +37,19 @@ fn backends() -> Vec<(&'static str, Make)> {
     {
         v.push((
             "cholmod-default",
-            Box::new(|| Box::new(fibercell_cholmod::Cholmod::new(Ordering::Auto))),
+            Box::new(|| Box::new(fibercell_cholmod::Cholmod::new(FillOrdering::Auto))),
         ));
         v.push((
             "cholmod-amd",
-            Box::new(|| Box::new(fibercell_cholmod::Cholmod::new(Ordering::Amd))),
+            Box::new(|| Box::new(fibercell_cholmod::Cholmod::new(FillOrdering::Amd))),
         ));
         v.push((
             "cholmod-nd",
-            Box::new(|| Box::new(fibercell_cholmod::Cholmod::new(Ordering::NestedDissection))),
+            Box::new(|| {
+                Box::new(fibercell_cholmod::Cholmod::new(
+                    FillOrdering::NestedDissection,
+                ))
+            }),
         ));
     }
     v
@@ -126,7 +130,7 @@ fn solvers(c: &mut Criterion) {
         c,
         "solvers/grid10",
         "faer-llt-amd",
-        &|| Box::new(FaerCholesky::new(CholeskyVariant::Llt, Ordering::Amd)),
+        &|| Box::new(FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::Amd)),
         &sys,
     );
 }

@@ -5,7 +5,7 @@ use fibercell::io::NetworkFormat;
 use fibercell::solve::{
     solve_incremental, solve_static, IncrementalOptions, SolveOptions, SolverKind,
 };
-use fibercell::solver::Ordering;
+use fibercell::solver::FillOrdering;
 use fibercell::{io, Error};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -32,7 +32,7 @@ struct SolverArgs {
     /// Fill-reducing ordering of the Cholesky backends: auto (the better of amd and nd by
     /// predicted flops), amd, nd (nested dissection, METIS) or natural.
     #[arg(long, default_value = "auto", value_parser = ordering_parser())]
-    ordering: Ordering,
+    ordering: FillOrdering,
 }
 
 impl SolverArgs {
@@ -472,9 +472,10 @@ fn vtk_parser() -> impl clap::builder::TypedValueParser<Value = io::VtkEncoding>
 }
 
 /// `--ordering`: the orderings' names, listed in `--help`.
-fn ordering_parser() -> impl clap::builder::TypedValueParser<Value = Ordering> {
+fn ordering_parser() -> impl clap::builder::TypedValueParser<Value = FillOrdering> {
     use clap::builder::TypedValueParser;
-    clap::builder::PossibleValuesParser::new(Ordering::NAMES).try_map(|s| Ordering::parse(&s))
+    clap::builder::PossibleValuesParser::new(FillOrdering::NAMES)
+        .try_map(|s| FillOrdering::parse(&s))
 }
 
 fn parse_strain(s: &str) -> Result<fibercell::cell::MacroStrain, String> {

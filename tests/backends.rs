@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use fibercell::solve::{solve_static, ReducedSystem, SolveOptions, SolverConfig, SolverKind};
 use fibercell::solver::{
-    solve_checked, CscMatrix, CscRef, LinearSolver, Ordering, SolverError, StopReason,
+    solve_checked, CscMatrix, CscRef, FillOrdering, LinearSolver, SolverError, StopReason,
 };
 use fibercell::{io, Error};
 use fibercell_cg::ConjugateGradient;
@@ -16,10 +16,10 @@ use std::path::Path;
 fn direct_solvers() -> Vec<(String, Box<dyn LinearSolver>)> {
     let mut v: Vec<(String, Box<dyn LinearSolver>)> = Vec::new();
     for o in [
-        Ordering::Auto,
-        Ordering::Natural,
-        Ordering::Amd,
-        Ordering::NestedDissection,
+        FillOrdering::Auto,
+        FillOrdering::Natural,
+        FillOrdering::Amd,
+        FillOrdering::NestedDissection,
     ] {
         for var in [CholeskyVariant::Llt, CholeskyVariant::Ldlt] {
             v.push((
@@ -67,12 +67,12 @@ fn every_backend_and_ordering_agrees() {
         let want = reference(a, &sys.rhs);
         let scale = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let mut solvers = direct_solvers();
-        let p = fibercell::solver::compute_ordering(a, &Ordering::NestedDissection).unwrap();
+        let p = fibercell::solver::compute_ordering(a, &FillOrdering::NestedDissection).unwrap();
         solvers.push((
             "faer given".into(),
             Box::new(FaerCholesky::new(
                 CholeskyVariant::Llt,
-                Ordering::Given(p.fwd),
+                FillOrdering::Given(p.fwd),
             )),
         ));
         solvers.push((
@@ -284,11 +284,16 @@ fn not_positive_definite_is_reported_at_the_right_column() {
         .unwrap();
     #[allow(unused_mut)] // pushed to with the cholmod feature
     let mut solvers: Vec<Box<dyn LinearSolver>> = vec![
-        Box::new(FaerCholesky::new(CholeskyVariant::Llt, Ordering::Natural)),
-        Box::new(FaerCholesky::new(CholeskyVariant::Ldlt, Ordering::Amd)),
+        Box::new(FaerCholesky::new(
+            CholeskyVariant::Llt,
+            FillOrdering::Natural,
+        )),
+        Box::new(FaerCholesky::new(CholeskyVariant::Ldlt, FillOrdering::Amd)),
     ];
     #[cfg(feature = "cholmod")]
-    solvers.push(Box::new(fibercell_cholmod::Cholmod::new(Ordering::Natural)));
+    solvers.push(Box::new(fibercell_cholmod::Cholmod::new(
+        FillOrdering::Natural,
+    )));
     for mut s in solvers {
         s.analyze(a.as_ref()).unwrap();
         match s.factorize(a.as_ref()) {
@@ -303,7 +308,7 @@ fn not_positive_definite_is_reported_at_the_right_column() {
     for (blocks, size) in [(3, 4), (6, 40)] {
         let bad = blocks / 2;
         let a = block_diag_with_singular_block(blocks, size, bad);
-        for o in [Ordering::Natural, Ordering::Amd] {
+        for o in [FillOrdering::Natural, FillOrdering::Amd] {
             for var in [CholeskyVariant::Llt, CholeskyVariant::Ldlt] {
                 let mut s = FaerCholesky::new(var, o.clone());
                 s.analyze(a.as_ref()).unwrap();
@@ -321,7 +326,7 @@ fn not_positive_definite_is_reported_at_the_right_column() {
         }
         #[cfg(feature = "cholmod")]
         {
-            let mut s = fibercell_cholmod::Cholmod::new(Ordering::Auto);
+            let mut s = fibercell_cholmod::Cholmod::new(FillOrdering::Auto);
             s.analyze(a.as_ref()).unwrap();
             assert!(matches!(
                 s.factorize(a.as_ref()),
@@ -528,7 +533,7 @@ fn low_rank_update_and_downdate_match_a_refactorization() {
         Err(SolverError::Unavailable { .. })
     ));
     #[cfg(feature = "cholmod")]
-    for o in [Ordering::Auto, Ordering::NestedDissection] {
+    for o in [FillOrdering::Auto, FillOrdering::NestedDissection] {
         let n = a.nrows();
         let b: Vec<f64> = (0..n).map(|i| ((i % 7) as f64 - 3.0) * 1e-3).collect();
         let updated = plus_outer(a, w.as_ref(), 1.0);

@@ -64,7 +64,7 @@ fn switching_a_contact_to_sliding_removes_its_two_stick_columns() {
 #[cfg(feature = "cholmod")]
 #[test]
 fn a_cholmod_downdate_by_the_stick_columns_solves_the_switched_system() {
-    use fibercell::solver::{backward_error, LinearSolver, Ordering};
+    use fibercell::solver::{backward_error, FillOrdering, LinearSolver};
     let (model, sys) = cell();
     let n = sys.n_contacts();
     let switched = [1, n / 2, n - 2];
@@ -81,7 +81,7 @@ fn a_cholmod_downdate_by_the_stick_columns_solves_the_switched_system() {
         s.solve_in_place(&mut x, 1).unwrap();
         x
     };
-    let mut modified = fibercell_cholmod::Cholmod::new(Ordering::Auto);
+    let mut modified = fibercell_cholmod::Cholmod::new(FillOrdering::Auto);
     modified.analyze(a0).unwrap();
     modified.factorize(a0).unwrap();
     modified.update_factor(w.as_ref(), false).unwrap();

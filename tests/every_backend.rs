@@ -12,7 +12,7 @@
 use fibercell::homogenize::{elasto_plastic_curve, homogenize_elastic, CurveOptions};
 use fibercell::io::load_model;
 use fibercell::solve::{solve_static, IncrementalOptions, SolveOptions, SolverKind};
-use fibercell::solver::Ordering;
+use fibercell::solver::FillOrdering;
 use fibercell::Model;
 
 fn model(path: &str) -> Model {
@@ -27,7 +27,7 @@ fn backends() -> Vec<SolverKind> {
         .collect()
 }
 
-fn options(kind: SolverKind, ordering: Ordering) -> SolveOptions {
+fn options(kind: SolverKind, ordering: FillOrdering) -> SolveOptions {
     SolveOptions {
         solver: kind,
         ordering,
@@ -67,7 +67,7 @@ fn homogenize_agrees(path: &str, kinds: &[SolverKind], tol: impl Fn(SolverKind) 
     let m = model(path);
     let reference = homogenize_elastic(&m, &SolveOptions::default()).expect("faer-cholesky");
     for &kind in kinds {
-        let h = homogenize_elastic(&m, &options(kind, Ordering::Auto))
+        let h = homogenize_elastic(&m, &options(kind, FillOrdering::Auto))
             .unwrap_or_else(|e| panic!("{path}: {kind} fails: {e}"));
         assert_eq!(h.backend, kind.name());
         assert!(
@@ -115,7 +115,7 @@ fn curve_agrees_on_woven_and_knitted_cells() {
         let m = model(path);
         let run = |kind: SolverKind| {
             let incremental = IncrementalOptions {
-                solve: options(kind, Ordering::Auto),
+                solve: options(kind, FillOrdering::Auto),
                 ..IncrementalOptions::default()
             };
             elasto_plastic_curve(
@@ -160,10 +160,10 @@ fn solve_agrees_with_every_backend_and_ordering() {
         .fold(0.0f64, |s, v| s.max(v.abs()));
     for kind in backends() {
         for ordering in [
-            Ordering::Auto,
-            Ordering::Amd,
-            Ordering::NestedDissection,
-            Ordering::Natural,
+            FillOrdering::Auto,
+            FillOrdering::Amd,
+            FillOrdering::NestedDissection,
+            FillOrdering::Natural,
         ] {
             let s = solve_static(&m, &options(kind, ordering.clone()))
                 .unwrap_or_else(|e| panic!("{kind} {ordering:?}: {e}"));

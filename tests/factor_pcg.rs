@@ -3,7 +3,7 @@
 //! iterations in exact arithmetic (a few more in floating point), and it reports, rather than
 //! hides, a budget too small to converge.
 
-use fibercell::solver::{backward_error, pcg_with_factor, CscMatrix, LinearSolver, Ordering};
+use fibercell::solver::{backward_error, pcg_with_factor, CscMatrix, FillOrdering, LinearSolver};
 use fibercell_faer::{CholeskyVariant, FaerCholesky};
 
 /// The 5-point Laplacian of an m × m grid plus `shift` on the diagonal, with `bumps` added to
@@ -33,7 +33,7 @@ fn grid(m: usize, bumps: &[(usize, f64)]) -> CscMatrix {
 fn a_rank_k_change_converges_in_k_plus_one_iterations() {
     let m = 40;
     let a0 = grid(m, &[]);
-    let mut factor = FaerCholesky::new(CholeskyVariant::Llt, Ordering::Amd);
+    let mut factor = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::Amd);
     factor.analyze(a0.as_ref()).expect("analyze");
     factor.factorize(a0.as_ref()).expect("factorize");
     let b: Vec<f64> = (0..m * m).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
@@ -64,7 +64,7 @@ fn a_rank_k_change_converges_in_k_plus_one_iterations() {
 fn a_budget_too_small_is_reported_not_hidden() {
     let m = 30;
     let a0 = grid(m, &[]);
-    let mut factor = FaerCholesky::new(CholeskyVariant::Llt, Ordering::Amd);
+    let mut factor = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::Amd);
     factor.analyze(a0.as_ref()).expect("analyze");
     factor.factorize(a0.as_ref()).expect("factorize");
     let bumps: Vec<(usize, f64)> = (0..20).map(|i| (5 + 41 * i, 30.0)).collect();

@@ -7,7 +7,7 @@
 
 use fibercell::solve::{SolverConfig, SolverKind};
 use fibercell::solver::{
-    compute_ordering, solve_checked, CscMatrix, CscRef, LinearSolver, Ordering, SolverError,
+    compute_ordering, solve_checked, CscMatrix, CscRef, FillOrdering, LinearSolver, SolverError,
 };
 
 /// A symmetric positive definite 1D Laplacian of order `n` with a coupling two apart, both
@@ -41,12 +41,12 @@ fn triangle(a: &CscMatrix, lower: bool) -> CscMatrix {
     CscMatrix::from_triplets(a.nrows(), a.ncols(), &t).expect("triangle")
 }
 
-fn orderings() -> Vec<Ordering> {
+fn orderings() -> Vec<FillOrdering> {
     vec![
-        Ordering::Auto,
-        Ordering::Amd,
-        Ordering::NestedDissection,
-        Ordering::Natural,
+        FillOrdering::Auto,
+        FillOrdering::Amd,
+        FillOrdering::NestedDissection,
+        FillOrdering::Natural,
     ]
 }
 
@@ -77,7 +77,11 @@ fn one_triangle_is_refused_by_every_ordering_and_symmetric_backend() {
     let a = full(400);
     for lower in [true, false] {
         let t = triangle(&a, lower);
-        for o in [Ordering::Amd, Ordering::NestedDissection, Ordering::Auto] {
+        for o in [
+            FillOrdering::Amd,
+            FillOrdering::NestedDissection,
+            FillOrdering::Auto,
+        ] {
             let e = compute_ordering(t.as_ref(), &o).expect_err("a triangle is refused");
             assert!(
                 matches!(e, SolverError::NotStructurallySymmetric { .. }),

@@ -17,7 +17,7 @@ use crate::solve::{
     SparseColumn,
 };
 use crate::Error;
-use fibercell_solver::{backward_error, pcg_with_factor, CscRef, Ordering};
+use fibercell_solver::{backward_error, pcg_with_factor, CscRef, FillOrdering};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -340,34 +340,34 @@ pub struct CellBench {
 /// its default and with the same nested dissection as faer. Block-Jacobi CG needs tens of
 /// thousands of iterations on slender-fiber systems: it enters as the factor-preconditioned
 /// solve after contact switches instead ([`ReuseBench`]).
-fn backends() -> Vec<(String, SolverKind, Ordering)> {
+fn backends() -> Vec<(String, SolverKind, FillOrdering)> {
     let mut v = vec![
         (
             "faer-cholesky/auto".to_string(),
             SolverKind::FaerCholesky,
-            Ordering::Auto,
+            FillOrdering::Auto,
         ),
         (
             "faer-cholesky/amd".into(),
             SolverKind::FaerCholesky,
-            Ordering::Amd,
+            FillOrdering::Amd,
         ),
         (
             "faer-cholesky/nd".into(),
             SolverKind::FaerCholesky,
-            Ordering::NestedDissection,
+            FillOrdering::NestedDissection,
         ),
     ];
     if cfg!(feature = "cholmod") {
         v.push((
             "cholmod/default".into(),
             SolverKind::Cholmod,
-            Ordering::Auto,
+            FillOrdering::Auto,
         ));
         v.push((
             "cholmod/nd".into(),
             SolverKind::Cholmod,
-            Ordering::NestedDissection,
+            FillOrdering::NestedDissection,
         ));
     }
     v
@@ -376,7 +376,7 @@ fn backends() -> Vec<(String, SolverKind, Ordering)> {
 fn bench_backend(
     name: &str,
     kind: SolverKind,
-    ordering: &Ordering,
+    ordering: &FillOrdering,
     a: CscRef<'_>,
     rhs: &[f64],
     repeats: usize,

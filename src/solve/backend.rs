@@ -1,7 +1,7 @@
 //! The backends the mechanics can use, by name.
 
 use crate::Error;
-use fibercell_solver::{LinearSolver, Ordering};
+use fibercell_solver::{FillOrdering, LinearSolver};
 use std::fmt;
 use std::str::FromStr;
 
@@ -73,7 +73,7 @@ pub struct SolverConfig {
     pub kind: SolverKind,
     /// Fill-reducing ordering of the direct backends (ignored by faer-lu, which orders its
     /// columns by COLAMD, and by CG).
-    pub ordering: Ordering,
+    pub ordering: FillOrdering,
     /// First unknown of every node block, increasing from 0 (CG's preconditioner); empty for
     /// uniform blocks of six unknowns.
     pub node_blocks: Vec<usize>,

@@ -5,7 +5,7 @@ use crate::assembly::FillMode;
 use crate::constraints::{locate, support_reactions, Reaction};
 use crate::model::Model;
 use crate::Error;
-use fibercell_solver::{solve_checked, Ordering, SolverError};
+use fibercell_solver::{solve_checked, FillOrdering, SolverError};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -15,7 +15,7 @@ pub struct SolveOptions {
     /// Backend.
     pub solver: SolverKind,
     /// Fill-reducing ordering for the direct backends.
-    pub ordering: Ordering,
+    pub ordering: FillOrdering,
     /// Serial or parallel value fill.
     pub fill: FillMode,
     /// Largest accepted normwise backward error ‖Ku − F‖∞/(‖K‖∞‖u‖∞ + ‖F‖∞) (default 1e-10
@@ -37,7 +37,7 @@ impl SolveOptions {
         }
         Ok(SolveOptions {
             solver: kind,
-            ordering: Ordering::parse(ordering).map_err(Error::InvalidOption)?,
+            ordering: FillOrdering::parse(ordering).map_err(Error::InvalidOption)?,
             ..SolveOptions::default()
         })
     }
@@ -61,7 +61,7 @@ pub struct Timings {
     pub pattern: f64,
     /// Value fill and right-hand side.
     pub fill: f64,
-    /// Ordering and symbolic factorization.
+    /// FillOrdering and symbolic factorization.
     pub analyze: f64,
     /// Numeric factorization.
     pub factorize: f64,
@@ -74,7 +74,7 @@ pub struct Timings {
 pub struct SolveSummary {
     /// Backend name.
     pub backend: String,
-    /// Ordering used.
+    /// FillOrdering used.
     pub ordering: String,
     /// Nodes × 6.
     pub dofs: usize,

@@ -1,6 +1,24 @@
 //! Preconditioned conjugate gradients for symmetric positive definite systems, with a
 //! node-block Jacobi preconditioner (the inverse of each diagonal block, 6×6 for frame nodes)
 //! and a rayon-parallel sparse matrix-vector product.
+//!
+//! ```
+//! use fibercell_cg::ConjugateGradient;
+//! use fibercell_solver::{CscMatrix, LinearSolver};
+//!
+//! let t = [(0, 0, 4.0), (1, 1, 4.0), (2, 2, 4.0), (0, 1, -1.0), (1, 0, -1.0), (1, 2, -1.0), (2, 1, -1.0)];
+//! let a = CscMatrix::from_triplets(3, 3, &t)?;
+//! let mut cg = ConjugateGradient::new();
+//! cg.analyze(a.as_ref())?;
+//! cg.factorize(a.as_ref())?; // the preconditioner
+//! let mut x = vec![3.0, 2.0, 3.0];
+//! let info = cg.solve_in_place(&mut x, 1)?;
+//! assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-8));
+//! assert!(info.iterations.is_some());
+//! # Ok::<(), fibercell_solver::SolverError>(())
+//! ```
+
+#![warn(missing_docs)]
 
 mod block_jacobi;
 

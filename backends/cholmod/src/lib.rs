@@ -4,12 +4,29 @@
 //! owned by RAII wrappers and freed in `Drop`. CHOLMOD reports a non-positive-definite matrix as
 //! a *warning* (`status = CHOLMOD_NOT_POSDEF`, `L->minor < n`) while returning success: both are
 //! checked after every factorization.
+//!
+//! ```
+//! use fibercell_cholmod::Cholmod;
+//! use fibercell_solver::{CscMatrix, LinearSolver};
+//!
+//! let t = [(0, 0, 4.0), (1, 1, 4.0), (2, 2, 4.0), (0, 1, -1.0), (1, 0, -1.0), (1, 2, -1.0), (2, 1, -1.0)];
+//! let a = CscMatrix::from_triplets(3, 3, &t)?;
+//! let mut cholmod = Cholmod::default();
+//! cholmod.analyze(a.as_ref())?;
+//! cholmod.factorize(a.as_ref())?;
+//! let mut x = vec![3.0, 2.0, 3.0];
+//! cholmod.solve_in_place(&mut x, 1)?;
+//! assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-14));
+//! # Ok::<(), fibercell_solver::SolverError>(())
+//! ```
+
+#![warn(missing_docs)]
 
 mod common;
 
 use common::Common;
 use fibercell_solver::{
-    compute_ordering, AnalyzeInfo, Capabilities, CscRef, LinearSolver, LowerTriangle, Ordering,
+    compute_ordering, AnalyzeInfo, Capabilities, CscRef, FillOrdering, LinearSolver, LowerTriangle,
     PatternFingerprint, SolveInfo, SolverError,
 };
 use std::os::raw::{c_int, c_long, c_void};
@@ -17,7 +34,7 @@ use suitesparse_sys as ss;
 
 /// CHOLMOD sparse Cholesky (supernodal or simplicial, CHOLMOD's choice).
 pub struct Cholmod {
-    ordering: Ordering,
+    ordering: FillOrdering,
     pivot_tolerance: f64,
     common: Option<Common>,
     state: Option<State>,
@@ -45,13 +62,13 @@ unsafe impl Send for Cholmod {}
 
 impl Default for Cholmod {
     fn default() -> Self {
-        Self::new(Ordering::Auto)
+        Self::new(FillOrdering::Auto)
     }
 }
 
 impl Cholmod {
-    /// A solver with the given ordering ([`Ordering::Auto`]: CHOLMOD's default strategy).
-    pub fn new(ordering: Ordering) -> Self {
+    /// A solver with the given ordering ([`FillOrdering::Auto`]: CHOLMOD's default strategy).
+    pub fn new(ordering: FillOrdering) -> Self {
         Cholmod {
             ordering,
             pivot_tolerance: 1e-12,
@@ -157,10 +174,10 @@ impl LinearSolver for Cholmod {
         let row_idx = to_long(&lower.row_idx)?;
         let mut perm: Option<Vec<c_long>> = None;
         let (nmethods, method, name) = match &self.ordering {
-            Ordering::Auto => (0, ss::CHOLMOD_AMD, "cholmod-default"),
-            Ordering::Natural => (1, ss::CHOLMOD_NATURAL, "natural"),
-            Ordering::Amd => (1, ss::CHOLMOD_AMD, "amd"),
-            o @ (Ordering::NestedDissection | Ordering::Given(_)) => {
+            FillOrdering::Auto => (0, ss::CHOLMOD_AMD, "cholmod-default"),
+            FillOrdering::Natural => (1, ss::CHOLMOD_NATURAL, "natural"),
+            FillOrdering::Amd => (1, ss::CHOLMOD_AMD, "amd"),
+            o @ (FillOrdering::NestedDissection | FillOrdering::Given(_)) => {
                 let p = compute_ordering(a, o)?;
                 perm = Some(p.fwd.iter().map(|&x| x as c_long).collect());
                 (1, ss::CHOLMOD_GIVEN, o.name())

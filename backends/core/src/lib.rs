@@ -7,7 +7,7 @@
 //! * the [`LinearSolver`] trait with separate *analyze* (ordering + symbolic factorization, once
 //!   per sparsity pattern), *factorize* (numeric, whenever values change) and *solve* (any number of
 //!   right-hand sides) phases;
-//! * fill-reducing [`Ordering`]s: approximate minimum degree, nested dissection (METIS
+//! * fill-reducing [`FillOrdering`]s: approximate minimum degree, nested dissection (METIS
 //!   `METIS_NodeND`, feature `metis`), natural or a given permutation;
 //! * typed [`SolverError`]s and [`solve_checked`], which reports the relative residual
 //!   ‖Ax − b‖/‖b‖ of every solve and never returns a non-finite solution.
@@ -36,7 +36,7 @@ pub use factor_pcg::{pcg_with_factor, FactorPcg};
 pub use forward::{ForwardBlock, ForwardColumns};
 pub use lower::LowerTriangle;
 pub use matrix_market::{read_matrix_market, read_matrix_market_dense};
-pub use ordering::{compute_ordering, Ordering, Permutation};
+pub use ordering::{compute_ordering, FillOrdering, Permutation};
 pub use residual::{
     backward_error, backward_from_product, norm_inf, norm_inf_symmetric_par, relative_from_product,
     relative_residual, solve_checked, vector_norm_inf, SolveReport,

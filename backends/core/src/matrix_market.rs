@@ -110,6 +110,14 @@ fn finite(line: usize, v: f64) -> Result<f64, SolverError> {
 /// A sparse matrix from the text of a `coordinate` Matrix Market file. A `symmetric` or
 /// `skew-symmetric` file stores one triangle; the result stores both (what the symmetric
 /// backends need). Duplicate entries are summed, as the format allows.
+///
+/// ```
+/// let text = "%%MatrixMarket matrix coordinate real symmetric\n\
+///             3 3 4\n1 1 4.0\n2 1 -1.0\n2 2 4.0\n3 3 2.5\n";
+/// let a = fibercell_solver::read_matrix_market(text)?;
+/// assert_eq!((a.as_ref().ncols(), a.as_ref().nnz()), (3, 5)); // both triangles
+/// # Ok::<(), fibercell_solver::SolverError>(())
+/// ```
 pub fn read_matrix_market(text: &str) -> Result<CscMatrix, SolverError> {
     let Parsed {
         layout,

@@ -8,7 +8,7 @@ use faer::sparse::SymbolicSparseColMatRef;
 
 /// Which fill-reducing ordering a direct solver uses.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub enum Ordering {
+pub enum FillOrdering {
     /// The backend's choice (faer: the better of AMD and nested dissection by predicted fill;
     /// CHOLMOD: its own default strategy).
     #[default]
@@ -25,28 +25,28 @@ pub enum Ordering {
     Given(Vec<usize>),
 }
 
-impl Ordering {
+impl FillOrdering {
     /// A short name for reports.
     pub fn name(&self) -> &'static str {
         match self {
-            Ordering::Auto => "auto",
-            Ordering::Natural => "natural",
-            Ordering::Amd => "amd",
-            Ordering::NestedDissection => "nested-dissection",
-            Ordering::Given(_) => "given",
+            FillOrdering::Auto => "auto",
+            FillOrdering::Natural => "natural",
+            FillOrdering::Amd => "amd",
+            FillOrdering::NestedDissection => "nested-dissection",
+            FillOrdering::Given(_) => "given",
         }
     }
 
-    /// The names [`Ordering::parse`] takes, as the CLI's `--ordering` lists them.
+    /// The names [`FillOrdering::parse`] takes, as the CLI's `--ordering` lists them.
     pub const NAMES: [&'static str; 4] = ["auto", "amd", "nd", "natural"];
 
-    /// The ordering called `name` (one of [`Ordering::NAMES`]; `nested-dissection` too).
-    pub fn parse(name: &str) -> Result<Ordering, String> {
+    /// The ordering called `name` (one of [`FillOrdering::NAMES`]; `nested-dissection` too).
+    pub fn parse(name: &str) -> Result<FillOrdering, String> {
         match name {
-            "auto" => Ok(Ordering::Auto),
-            "amd" => Ok(Ordering::Amd),
-            "nd" | "nested-dissection" => Ok(Ordering::NestedDissection),
-            "natural" => Ok(Ordering::Natural),
+            "auto" => Ok(FillOrdering::Auto),
+            "amd" => Ok(FillOrdering::Amd),
+            "nd" | "nested-dissection" => Ok(FillOrdering::NestedDissection),
+            "natural" => Ok(FillOrdering::Natural),
             _ => Err(format!(
                 "unknown ordering \"{name}\" (use auto, amd, nd or natural)"
             )),
@@ -95,9 +95,12 @@ impl Permutation {
 
 /// Computes the permutation for a concrete ordering from the pattern of the square,
 /// structurally symmetric matrix `a` (checked: AMD and METIS need a symmetric graph and hang or
-/// return nonsense on one triangle). [`Ordering::Auto`] is resolved by the backends; here it
+/// return nonsense on one triangle). [`FillOrdering::Auto`] is resolved by the backends; here it
 /// means AMD.
-pub fn compute_ordering(a: CscRef<'_>, ordering: &Ordering) -> Result<Permutation, SolverError> {
+pub fn compute_ordering(
+    a: CscRef<'_>,
+    ordering: &FillOrdering,
+) -> Result<Permutation, SolverError> {
     let n = a.ncols();
     if a.nrows() != n {
         return Err(SolverError::DimensionMismatch(format!(
@@ -105,14 +108,14 @@ pub fn compute_ordering(a: CscRef<'_>, ordering: &Ordering) -> Result<Permutatio
             a.nrows()
         )));
     }
-    if !matches!(ordering, Ordering::Given(_) | Ordering::Natural) {
+    if !matches!(ordering, FillOrdering::Given(_) | FillOrdering::Natural) {
         a.check_structurally_symmetric()?;
     }
     match ordering {
-        Ordering::Natural => Ok(Permutation::identity(n)),
-        Ordering::Given(p) => Permutation::from_fwd(p.clone(), n),
-        Ordering::Auto | Ordering::Amd => amd_ordering(a),
-        Ordering::NestedDissection => nested_dissection(a),
+        FillOrdering::Natural => Ok(Permutation::identity(n)),
+        FillOrdering::Given(p) => Permutation::from_fwd(p.clone(), n),
+        FillOrdering::Auto | FillOrdering::Amd => amd_ordering(a),
+        FillOrdering::NestedDissection => nested_dissection(a),
     }
 }
 
@@ -190,13 +193,13 @@ mod tests {
     #[test]
     fn nested_dissection_is_the_same_on_concurrent_threads() {
         let a = grid_laplacian(30, 3);
-        let want = compute_ordering(a.as_ref(), &Ordering::NestedDissection).unwrap();
+        let want = compute_ordering(a.as_ref(), &FillOrdering::NestedDissection).unwrap();
         std::thread::scope(|scope| {
             let runs: Vec<_> = (0..4)
                 .map(|_| {
                     scope.spawn(|| {
                         (0..20)
-                            .map(|_| compute_ordering(a.as_ref(), &Ordering::NestedDissection))
+                            .map(|_| compute_ordering(a.as_ref(), &FillOrdering::NestedDissection))
                             .collect::<Vec<_>>()
                     })
                 })
@@ -212,9 +215,9 @@ mod tests {
     #[test]
     fn every_ordering_is_a_permutation() {
         let a = grid_laplacian(12, 3);
-        let mut orderings = vec![Ordering::Natural, Ordering::Amd];
+        let mut orderings = vec![FillOrdering::Natural, FillOrdering::Amd];
         if cfg!(feature = "metis") {
-            orderings.push(Ordering::NestedDissection);
+            orderings.push(FillOrdering::NestedDissection);
         }
         for o in orderings {
             let p = compute_ordering(a.as_ref(), &o).unwrap();
@@ -231,7 +234,7 @@ mod tests {
     #[test]
     fn nested_dissection_keeps_supervariables_together() {
         let a = grid_laplacian(10, 6);
-        let p = compute_ordering(a.as_ref(), &Ordering::NestedDissection).unwrap();
+        let p = compute_ordering(a.as_ref(), &FillOrdering::NestedDissection).unwrap();
         for chunk in p.fwd.chunks(6) {
             assert_eq!(chunk[0] % 6, 0);
             for (k, &c) in chunk.iter().enumerate() {
@@ -245,7 +248,7 @@ mod tests {
     #[test]
     fn nested_dissection_needs_the_metis_feature() {
         let a = grid_laplacian(3, 1);
-        let e = compute_ordering(a.as_ref(), &Ordering::NestedDissection);
+        let e = compute_ordering(a.as_ref(), &FillOrdering::NestedDissection);
         assert!(matches!(
             e,
             Err(SolverError::Unavailable {
@@ -260,10 +263,10 @@ mod tests {
         let a = grid_laplacian(3, 1);
         let e = compute_ordering(
             a.as_ref(),
-            &Ordering::Given(vec![0, 1, 1, 3, 4, 5, 6, 7, 8]),
+            &FillOrdering::Given(vec![0, 1, 1, 3, 4, 5, 6, 7, 8]),
         );
         assert!(matches!(e, Err(SolverError::InvalidMatrix(_))));
-        let e = compute_ordering(a.as_ref(), &Ordering::Given(vec![0]));
+        let e = compute_ordering(a.as_ref(), &FillOrdering::Given(vec![0]));
         assert!(matches!(e, Err(SolverError::DimensionMismatch(_))));
     }
 }

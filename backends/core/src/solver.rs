@@ -11,7 +11,7 @@ pub struct Capabilities {
     pub reuses_symbolic: bool,
     /// An iterative method (the solve has a tolerance and may not converge).
     pub iterative: bool,
-    /// Honours the requested fill-reducing [`crate::Ordering`].
+    /// Honours the requested fill-reducing [`crate::FillOrdering`].
     pub selectable_ordering: bool,
 }
 
@@ -60,7 +60,7 @@ pub trait LinearSolver: Send {
     fn name(&self) -> &'static str;
     /// What the backend can do.
     fn capabilities(&self) -> Capabilities;
-    /// Ordering and symbolic factorization; only the pattern of `a` is used.
+    /// FillOrdering and symbolic factorization; only the pattern of `a` is used.
     fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError>;
     /// Numeric factorization of `a`, whose pattern must be the analysed one.
     fn factorize(&mut self, a: CscRef<'_>) -> Result<(), SolverError>;

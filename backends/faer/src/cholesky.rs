@@ -21,8 +21,8 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use fibercell_solver::{
-    compute_ordering, AnalyzeInfo, Capabilities, CscRef, ForwardColumns, LinearSolver,
-    LowerTriangle, Ordering, PatternFingerprint, Permutation, SolveInfo, SolverError,
+    compute_ordering, AnalyzeInfo, Capabilities, CscRef, FillOrdering, ForwardColumns,
+    LinearSolver, LowerTriangle, PatternFingerprint, Permutation, SolveInfo, SolverError,
 };
 use std::sync::Arc;
 
@@ -40,7 +40,7 @@ pub enum CholeskyVariant {
 /// lower one is read).
 pub struct FaerCholesky {
     variant: CholeskyVariant,
-    ordering: Ordering,
+    ordering: FillOrdering,
     pivot_tolerance: f64,
     par: Par,
     /// Shared with the solvers [`LinearSolver::share`] made (read-only).
@@ -78,7 +78,7 @@ struct Factor {
 
 impl Default for FaerCholesky {
     fn default() -> Self {
-        Self::new(CholeskyVariant::Llt, Ordering::Auto)
+        Self::new(CholeskyVariant::Llt, FillOrdering::Auto)
     }
 }
 
@@ -95,7 +95,7 @@ fn factor_view<'a>(an: &'a Analysis, f: &'a Factor) -> FactorView<'a> {
 impl FaerCholesky {
     /// A solver with the given variant and ordering, relative pivot tolerance 1e-12 and all
     /// rayon threads.
-    pub fn new(variant: CholeskyVariant, ordering: Ordering) -> Self {
+    pub fn new(variant: CholeskyVariant, ordering: FillOrdering) -> Self {
         FaerCholesky {
             variant,
             ordering,
@@ -230,18 +230,18 @@ impl LinearSolver for FaerCholesky {
             &lower_tri.row_idx,
         );
         let (perm, symbolic, name) = match &self.ordering {
-            Ordering::Auto => {
+            FillOrdering::Auto => {
                 // Both candidates side by side (METIS and AMD are sequential), keep the one
                 // with fewer predicted flops (AMD on a tie).
-                let candidate = |o: Ordering| -> Result<_, SolverError> {
+                let candidate = |o: FillOrdering| -> Result<_, SolverError> {
                     let p = compute_ordering(a, &o)?;
                     let s = self.symbolic_for(lower, &p)?;
                     let flops = fill_and_flops(&s).1;
                     Ok((p, s, flops))
                 };
                 let (amd, nd) = rayon::join(
-                    || candidate(Ordering::Amd),
-                    || candidate(Ordering::NestedDissection),
+                    || candidate(FillOrdering::Amd),
+                    || candidate(FillOrdering::NestedDissection),
                 );
                 // Without METIS (fibercell-solver's `metis` feature) AMD alone.
                 let nd = match nd {

@@ -538,7 +538,7 @@ mod tests {
     use crate::test_matrices::{grid, grid_factor};
     use crate::{CholeskyVariant, FaerCholesky};
     use faer::Par;
-    use fibercell_solver::{ForwardColumns, LinearSolver, Ordering, SolverError};
+    use fibercell_solver::{FillOrdering, ForwardColumns, LinearSolver, SolverError};
 
     /// Sparse columns: single entries, a repeated column, entries far apart.
     fn columns(n: usize) -> Vec<Vec<(usize, f64)>> {
@@ -574,13 +574,13 @@ mod tests {
     #[test]
     fn gram_of_sparse_forward_solves_is_b_transpose_a_inverse_b() {
         for (k, supernodal) in [(4, false), (16, true)] {
-            for ordering in [Ordering::Natural, Ordering::NestedDissection] {
+            for ordering in [FillOrdering::Natural, FillOrdering::NestedDissection] {
                 let a = grid(k);
                 let n = k * k * k;
                 let mut s = FaerCholesky::new(CholeskyVariant::Llt, ordering.clone());
                 s.analyze(a.as_ref()).unwrap();
                 s.factorize(a.as_ref()).unwrap();
-                if ordering == Ordering::NestedDissection {
+                if ordering == FillOrdering::NestedDissection {
                     assert_eq!(s.is_supernodal(), Some(supernodal), "k = {k}");
                 }
                 let b = columns(n);
@@ -597,7 +597,7 @@ mod tests {
                 // The empty column reaches nothing; on the large grid with nested dissection a
                 // column reaches a small part of the factor.
                 assert!(w.blocks.iter().all(|blk| !blk.columns.contains(&5)));
-                if supernodal && ordering == Ordering::NestedDissection {
+                if supernodal && ordering == FillOrdering::NestedDissection {
                     assert!(w.nnz() < b.len() * n / 4, "{} of {}", w.nnz(), b.len() * n);
                 }
             }
@@ -887,7 +887,7 @@ mod tests {
     #[test]
     fn single_right_hand_side_solve_matches_two() {
         for k in [4, 16] {
-            for ordering in [Ordering::Natural, Ordering::NestedDissection] {
+            for ordering in [FillOrdering::Natural, FillOrdering::NestedDissection] {
                 let a = grid(k);
                 let n = k * k * k;
                 let mut s = FaerCholesky::new(CholeskyVariant::Llt, ordering.clone());
@@ -981,7 +981,7 @@ mod tests {
         for k in [4, 16] {
             let a = grid(k);
             let n = k * k * k;
-            let mut s = FaerCholesky::new(CholeskyVariant::Llt, Ordering::NestedDissection);
+            let mut s = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::NestedDissection);
             s.analyze(a.as_ref()).unwrap();
             s.factorize(a.as_ref()).unwrap();
             let b = columns(n);
@@ -1019,7 +1019,7 @@ mod tests {
     #[test]
     fn sparse_forward_solve_rejects_bad_columns_and_ldlt() {
         let a = grid(4);
-        let mut s = FaerCholesky::new(CholeskyVariant::Llt, Ordering::Amd);
+        let mut s = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::Amd);
         assert!(matches!(
             s.forward_solve_sparse(&[vec![(0, 1.0)]]),
             Err(SolverError::OutOfOrder(..))
@@ -1032,7 +1032,7 @@ mod tests {
                 Err(SolverError::DimensionMismatch(_))
             ));
         }
-        let mut l = FaerCholesky::new(CholeskyVariant::Ldlt, Ordering::Amd);
+        let mut l = FaerCholesky::new(CholeskyVariant::Ldlt, FillOrdering::Amd);
         l.analyze(a.as_ref()).unwrap();
         l.factorize(a.as_ref()).unwrap();
         assert!(matches!(

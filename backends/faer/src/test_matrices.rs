@@ -1,12 +1,12 @@
 //! Test matrices of the solve modules' unit tests (below every one of them).
 
 use crate::{CholeskyVariant, FaerCholesky};
-use fibercell_solver::{CscMatrix, LinearSolver, Ordering};
+use fibercell_solver::{CscMatrix, FillOrdering, LinearSolver};
 
 /// The order, the matrix and the supernodal nested-dissection LLᵀ factor of `grid(k)`.
 pub(crate) fn grid_factor(k: usize) -> (usize, CscMatrix, FaerCholesky) {
     let a = grid(k);
-    let mut s = FaerCholesky::new(CholeskyVariant::Llt, Ordering::NestedDissection);
+    let mut s = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::NestedDissection);
     s.analyze(a.as_ref()).unwrap();
     s.factorize(a.as_ref()).unwrap();
     (k * k * k, a, s)
