@@ -1,7 +1,8 @@
 //! The documentation stays true to the repository: the README is a newcomer's page (at most
 //! 400 lines), every relative link of the README and of `docs/` reaches a file (and a heading,
 //! when it names one), and `docs/architecture.md` lists every source folder. (The Rust blocks
-//! of these pages run as doctests: `doc_examples` in `src/lib.rs`.)
+//! of these pages run as doctests: `doc_examples` in `src/lib.rs`; their command, Python and C
+//! blocks run in `.ci/doc_blocks.py`.)
 
 use std::path::{Path, PathBuf};
 
