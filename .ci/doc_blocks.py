@@ -74,6 +74,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--python", required=True, help="interpreter with the fibercell package")
     args = parser.parse_args()
+    # The blocks run in a scratch directory: the interpreter's path must not be relative.
+    python = os.path.abspath(args.python)
     pages = [os.path.join(ROOT, "README.md")] + sorted(
         os.path.join(ROOT, "docs", p) for p in os.listdir(os.path.join(ROOT, "docs")) if p.endswith(".md")
     )
@@ -116,7 +118,7 @@ def main():
                     script = os.path.join(scratch, "block.py")
                     with open(script, "w") as f:
                         f.write("\n".join(body) + "\n")
-                    run(f"{shlex.quote(args.python)} block.py", scratch, label, results)
+                    run(f"{shlex.quote(python)} block.py", scratch, label, results)
     passed, failed = results.count(True), results.count(False)
     print(f"test result: doc-blocks. {passed} passed; {failed} failed")
     sys.exit(1 if failed else 0)
