@@ -2,24 +2,20 @@
 //! `METIS_NodeND`), natural, or a permutation given by the caller.
 
 use crate::{CscRef, SolverError};
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::amd;
-use faer::sparse::SymbolicSparseColMatRef;
 
 /// Which fill-reducing ordering a direct solver uses.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub enum FillOrdering {
-    /// The backend's choice (faer: the better of AMD and nested dissection by predicted fill;
-    /// CHOLMOD: its own default strategy).
+    /// The backend's choice (faer and [`compute_ordering`]: the better of AMD and nested
+    /// dissection by predicted flops; CHOLMOD: its own default strategy).
     #[default]
     Auto,
     /// No reordering.
     Natural,
-    /// Approximate minimum degree.
+    /// Approximate minimum degree (faer's) on the [`NodeGraph`].
     Amd,
     /// Nested dissection through METIS `METIS_NodeND` (the best of five separators at each
-    /// level), on the graph compressed to supervariables (consecutive columns with identical
-    /// patterns, e.g. the six DOFs of a node).
+    /// level) on the [`NodeGraph`].
     NestedDissection,
     /// A caller's permutation: `perm[new] = old`.
     Given(Vec<usize>),
@@ -93,10 +89,10 @@ impl Permutation {
     }
 }
 
-/// Computes the permutation for a concrete ordering from the pattern of the square,
-/// structurally symmetric matrix `a` (checked: AMD and METIS need a symmetric graph and hang or
-/// return nonsense on one triangle). [`FillOrdering::Auto`] is resolved by the backends; here it
-/// means AMD.
+/// Computes the permutation of `ordering` from the pattern of the square, structurally
+/// symmetric matrix `a` (checked: AMD and METIS need a symmetric graph and hang or return
+/// nonsense on one triangle). AMD and nested dissection run on the matrix's [`NodeGraph`];
+/// [`FillOrdering::Auto`] is the one of the two with fewer predicted flops.
 pub fn compute_ordering(
     a: CscRef<'_>,
     ordering: &FillOrdering,
@@ -108,52 +104,17 @@ pub fn compute_ordering(
             a.nrows()
         )));
     }
-    if !matches!(ordering, FillOrdering::Given(_) | FillOrdering::Natural) {
-        a.check_structurally_symmetric()?;
-    }
     match ordering {
         FillOrdering::Natural => Ok(Permutation::identity(n)),
         FillOrdering::Given(p) => Permutation::from_fwd(p.clone(), n),
-        FillOrdering::Auto | FillOrdering::Amd => amd_ordering(a),
-        FillOrdering::NestedDissection => nested_dissection(a),
+        o => Ok(NodeGraph::of(a)?.order(o)?.0),
     }
 }
 
 #[cfg(feature = "metis")]
 mod metis;
-#[cfg(feature = "metis")]
-use metis::nested_dissection;
-
-/// Without the `metis` feature there is no nested dissection.
-#[cfg(not(feature = "metis"))]
-fn nested_dissection(_: CscRef<'_>) -> Result<Permutation, SolverError> {
-    Err(SolverError::Unavailable {
-        backend: "metis",
-        reason: "fibercell-solver was built without its `metis` feature".into(),
-    })
-}
-
-fn amd_ordering(a: CscRef<'_>) -> Result<Permutation, SolverError> {
-    let n = a.ncols();
-    let mut fwd = vec![0usize; n];
-    let mut inv = vec![0usize; n];
-    let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
-    let req = amd::order_scratch::<usize>(n, a.nnz());
-    let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
-    amd::order(
-        &mut fwd,
-        &mut inv,
-        pattern,
-        amd::Control::default(),
-        MemStack::new(&mut buf),
-    )
-    .map_err(|e| SolverError::Backend {
-        backend: "amd",
-        code: -1,
-        message: format!("{e:?}"),
-    })?;
-    Ok(Permutation { fwd, inv })
-}
+mod node_graph;
+pub use node_graph::{FillEstimate, NodeGraph};
 
 #[cfg(test)]
 mod tests {

@@ -22,7 +22,8 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use fibercell_solver::{
     compute_ordering, AnalyzeInfo, Capabilities, CscRef, FillOrdering, ForwardColumns,
-    LinearSolver, LowerTriangle, PatternFingerprint, Permutation, SolveInfo, SolverError,
+    LinearSolver, LowerTriangle, NodeGraph, PatternFingerprint, Permutation, SolveInfo,
+    SolverError,
 };
 use std::sync::Arc;
 
@@ -169,6 +170,23 @@ impl FaerCholesky {
         self
     }
 
+    /// The fill-reducing permutation of `a` (checked structurally symmetric) and its name.
+    /// AMD and nested dissection run on the node graph; Auto takes the one with fewer flops
+    /// predicted there, so only the winner gets a scalar symbolic factorization.
+    fn permutation(&self, a: CscRef<'_>) -> Result<(Permutation, String), SolverError> {
+        match &self.ordering {
+            o @ (FillOrdering::Auto | FillOrdering::Amd | FillOrdering::NestedDissection) => {
+                let (p, _, chosen) = NodeGraph::of_checked(a).order(o)?;
+                let name = match o {
+                    FillOrdering::Auto => format!("auto→{}", chosen.name()),
+                    o => o.name().to_string(),
+                };
+                Ok((p, name))
+            }
+            o => Ok((compute_ordering(a, o)?, o.name().to_string())),
+        }
+    }
+
     fn symbolic_for(
         &self,
         lower: SymbolicSparseColMatRef<'_, usize>,
@@ -221,7 +239,9 @@ impl LinearSolver for FaerCholesky {
         self.analysis = None;
         self.scratch = None;
         let n = a.ncols();
-        let lower_tri = LowerTriangle::of(a);
+        // The lower triangle is extracted while the ordering runs (METIS is sequential).
+        let (lower_tri, ordered) = rayon::join(|| LowerTriangle::of(a), || self.permutation(a));
+        let (perm, name) = ordered?;
         let lower = SymbolicSparseColMatRef::new_checked(
             n,
             n,
@@ -229,38 +249,7 @@ impl LinearSolver for FaerCholesky {
             None,
             &lower_tri.row_idx,
         );
-        let (perm, symbolic, name) = match &self.ordering {
-            FillOrdering::Auto => {
-                // Both candidates side by side (METIS and AMD are sequential), keep the one
-                // with fewer predicted flops (AMD on a tie).
-                let candidate = |o: FillOrdering| -> Result<_, SolverError> {
-                    let p = compute_ordering(a, &o)?;
-                    let s = self.symbolic_for(lower, &p)?;
-                    let flops = fill_and_flops(&s).1;
-                    Ok((p, s, flops))
-                };
-                let (amd, nd) = rayon::join(
-                    || candidate(FillOrdering::Amd),
-                    || candidate(FillOrdering::NestedDissection),
-                );
-                // Without METIS (fibercell-solver's `metis` feature) AMD alone.
-                let nd = match nd {
-                    Err(SolverError::Unavailable { .. }) => None,
-                    nd => Some(nd?),
-                };
-                let amd = amd?;
-                if let Some(nd) = nd.filter(|nd| nd.2 < amd.2) {
-                    (nd.0, nd.1, "auto→nested-dissection".to_string())
-                } else {
-                    (amd.0, amd.1, "auto→amd".to_string())
-                }
-            }
-            o => {
-                let p = compute_ordering(a, o)?;
-                let s = self.symbolic_for(lower, &p)?;
-                (p, s, o.name().to_string())
-            }
-        };
+        let symbolic = self.symbolic_for(lower, &perm)?;
         let (nnz_l, flops) = fill_and_flops(&symbolic);
         let tree = BlockTree::of(&symbolic);
         let info = AnalyzeInfo {

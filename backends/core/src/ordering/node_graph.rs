@@ -1,0 +1,407 @@
+//! The graph of a structurally symmetric matrix compressed to its nodes (supervariables:
+//! consecutive columns with identical patterns, e.g. the six DOFs of a beam node), the
+//! orderings computed on it, and the fill they predict for the scalar matrix.
+//!
+//! A fiber network's matrix is 6×6-blocked by node, so its node graph has 36× fewer edges than
+//! the scalar one: AMD and nested dissection run on it and the node order is expanded, each
+//! node's columns kept together. Because the blocks between nodes are full (below), the scalar
+//! factor's pattern is the node factor's pattern expanded, so nnz(L) and the flops of a
+//! candidate follow exactly from the node graph's elimination tree, without a scalar symbolic
+//! factorization.
+
+use super::{FillOrdering, Permutation};
+use crate::{CscRef, SolverError};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::amd;
+use faer::sparse::SymbolicSparseColMatRef;
+
+/// A structurally symmetric matrix's graph on its supervariables. Blocks between two
+/// supervariables are full or empty: if column j of group g holds row r of group h, every
+/// column of h (same pattern as r) holds j, so by symmetry every column of g holds all of h.
+#[derive(Clone, Debug)]
+pub struct NodeGraph {
+    /// First column of each node, and n at the end (`starts[g]..starts[g + 1]`).
+    starts: Vec<usize>,
+    /// Adjacency (other nodes, ascending, no self loop) in CSR form.
+    xadj: Vec<usize>,
+    adj: Vec<usize>,
+}
+
+/// The fill a node ordering predicts for the scalar matrix's Cholesky factor (exact for the
+/// pattern; faer's relaxed supernodes may store a few explicit zeros more).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FillEstimate {
+    /// Entries of L, diagonal included.
+    pub nnz_l: usize,
+    /// Σ c_j² over the factor's column counts c_j (a left-looking Cholesky's flops).
+    pub flops: f64,
+}
+
+impl NodeGraph {
+    /// The node graph of `a`, whose pattern must be square and symmetric (checked: AMD and
+    /// METIS hang or return nonsense on one triangle).
+    pub fn of(a: CscRef<'_>) -> Result<Self, SolverError> {
+        a.check_structurally_symmetric()?;
+        Ok(Self::of_checked(a))
+    }
+
+    /// [`NodeGraph::of`] for a pattern the caller has checked with
+    /// [`CscRef::check_structurally_symmetric`], as a backend's `analyze` does (on an
+    /// asymmetric pattern the orderings may hang or return nonsense).
+    pub fn of_checked(a: CscRef<'_>) -> Self {
+        let n = a.ncols();
+        let mut starts = Vec::new();
+        let mut group = vec![0usize; n];
+        for (j, g) in group.iter_mut().enumerate() {
+            if j == 0 || a.col(j).0 != a.col(j - 1).0 {
+                starts.push(j);
+            }
+            *g = starts.len() - 1;
+        }
+        let m = starts.len();
+        starts.push(n);
+        let mut xadj = Vec::with_capacity(m + 1);
+        let mut adj = Vec::with_capacity(a.nnz() / 16 + 1);
+        xadj.push(0);
+        for (g, &first) in starts[..m].iter().enumerate() {
+            let mut last = usize::MAX;
+            for &r in a.col(first).0 {
+                let h = group[r];
+                if h != g && h != last {
+                    adj.push(h);
+                    last = h;
+                }
+            }
+            xadj.push(adj.len());
+        }
+        NodeGraph { starts, xadj, adj }
+    }
+
+    /// Number of nodes.
+    pub fn nodes(&self) -> usize {
+        self.starts.len() - 1
+    }
+
+    /// Order of the scalar matrix.
+    pub fn order_of_matrix(&self) -> usize {
+        *self.starts.last().unwrap_or(&0)
+    }
+
+    /// Columns (unknowns) of node g.
+    pub fn weight(&self, g: usize) -> usize {
+        self.starts[g + 1] - self.starts[g]
+    }
+
+    /// Neighbours of node g (ascending, without g).
+    pub fn neighbours(&self, g: usize) -> &[usize] {
+        &self.adj[self.xadj[g]..self.xadj[g + 1]]
+    }
+
+    /// Stored adjacency entries (each edge twice).
+    pub fn edges(&self) -> usize {
+        self.adj.len()
+    }
+
+    /// The scalar permutation of `ordering` (AMD or nested dissection; [`FillOrdering::Auto`]
+    /// is the one of the two with fewer predicted flops, AMD on a tie) with its predicted fill
+    /// and the concrete ordering used.
+    pub fn order(
+        &self,
+        ordering: &FillOrdering,
+    ) -> Result<(Permutation, FillEstimate, FillOrdering), SolverError> {
+        let nodes = match ordering {
+            FillOrdering::Amd => self.amd()?,
+            FillOrdering::NestedDissection => self.nested_dissection()?,
+            FillOrdering::Auto => return self.better_of_amd_and_nested_dissection(),
+            FillOrdering::Natural | FillOrdering::Given(_) => {
+                return Err(SolverError::InvalidMatrix(format!(
+                    "the {} ordering is not computed on the node graph",
+                    ordering.name()
+                )))
+            }
+        };
+        let fill = self.fill(&nodes);
+        Ok((self.expand(&nodes)?, fill, ordering.clone()))
+    }
+
+    /// Both candidates side by side (METIS and AMD are sequential); without METIS (the
+    /// `metis` feature) AMD alone.
+    fn better_of_amd_and_nested_dissection(
+        &self,
+    ) -> Result<(Permutation, FillEstimate, FillOrdering), SolverError> {
+        let (amd, nd) = rayon::join(|| self.amd(), || self.nested_dissection());
+        let amd = amd?;
+        let amd_fill = self.fill(&amd);
+        let (nodes, fill, chosen) = match nd {
+            Err(SolverError::Unavailable { .. }) => (amd, amd_fill, FillOrdering::Amd),
+            nd => {
+                let nd = nd?;
+                let nd_fill = self.fill(&nd);
+                if nd_fill.flops < amd_fill.flops {
+                    (nd, nd_fill, FillOrdering::NestedDissection)
+                } else {
+                    (amd, amd_fill, FillOrdering::Amd)
+                }
+            }
+        };
+        Ok((self.expand(&nodes)?, fill, chosen))
+    }
+
+    /// The scalar permutation of a node order (`nodes[new] = old node`): each node's columns
+    /// consecutively, in their own order.
+    pub fn expand(&self, nodes: &[usize]) -> Result<Permutation, SolverError> {
+        let n = self.order_of_matrix();
+        let mut fwd = Vec::with_capacity(n);
+        for &g in nodes {
+            fwd.extend(self.starts[g]..self.starts[g + 1]);
+        }
+        Permutation::from_fwd(fwd, n)
+    }
+
+    /// AMD (faer's) on the node graph; its node order.
+    fn amd(&self) -> Result<Vec<usize>, SolverError> {
+        let m = self.nodes();
+        let mut fwd = vec![0usize; m];
+        let mut inv = vec![0usize; m];
+        let pattern = SymbolicSparseColMatRef::new_checked(m, m, &self.xadj, None, &self.adj);
+        let req = amd::order_scratch::<usize>(m, self.adj.len());
+        let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
+        amd::order(
+            &mut fwd,
+            &mut inv,
+            pattern,
+            amd::Control::default(),
+            MemStack::new(&mut buf),
+        )
+        .map_err(|e| SolverError::Backend {
+            backend: "amd",
+            code: -1,
+            message: format!("{e:?}"),
+        })?;
+        Ok(fwd)
+    }
+
+    /// Nested dissection by METIS on the node graph, weighted by node size.
+    #[cfg(feature = "metis")]
+    fn nested_dissection(&self) -> Result<Vec<usize>, SolverError> {
+        super::metis::node_nested_dissection(self)
+    }
+
+    /// Without the `metis` feature there is no nested dissection.
+    #[cfg(not(feature = "metis"))]
+    fn nested_dissection(&self) -> Result<Vec<usize>, SolverError> {
+        Err(SolverError::Unavailable {
+            backend: "metis",
+            reason: "fibercell-solver was built without its `metis` feature".into(),
+        })
+    }
+
+    /// The scalar factor's fill under a node order (`nodes[new] = old node`), from the node
+    /// graph's elimination tree: for each node i, the nodes of its row of L are the etree
+    /// paths from its lower neighbours up to i (George & Liu's row subtrees), so node j's
+    /// column below its diagonal block holds the weights of every i whose row subtree passes
+    /// j. Node j of width w with b unknowns below its block then has scalar column counts
+    /// w + b, w − 1 + b, …, 1 + b. O(nnz of the node factor).
+    pub fn fill(&self, nodes: &[usize]) -> FillEstimate {
+        let m = self.nodes();
+        let mut position = vec![0usize; m];
+        for (new, &old) in nodes.iter().enumerate() {
+            position[old] = new;
+        }
+        let parent = self.elimination_tree(nodes, &position);
+        let mut below = vec![0usize; m];
+        let mut mark = vec![usize::MAX; m];
+        for (i, &old) in nodes.iter().enumerate() {
+            mark[i] = i;
+            let w = self.weight(old);
+            for &k in self.neighbours(old) {
+                let mut r = position[k];
+                if r > i {
+                    continue;
+                }
+                while mark[r] != i {
+                    mark[r] = i;
+                    below[r] += w;
+                    r = parent[r];
+                }
+            }
+        }
+        let mut fill = FillEstimate {
+            nnz_l: 0,
+            flops: 0.0,
+        };
+        for (j, &old) in nodes.iter().enumerate() {
+            let b = below[j];
+            for k in 1..=self.weight(old) {
+                let c = k + b;
+                fill.nnz_l += c;
+                fill.flops += (c as f64) * (c as f64);
+            }
+        }
+        fill
+    }
+
+    /// Parent of each node in the elimination tree of the permuted node graph (Liu's algorithm
+    /// with path compression); a root's parent is itself.
+    fn elimination_tree(&self, nodes: &[usize], position: &[usize]) -> Vec<usize> {
+        let m = nodes.len();
+        let mut parent: Vec<usize> = (0..m).collect();
+        let mut ancestor = vec![usize::MAX; m];
+        for (i, &old) in nodes.iter().enumerate() {
+            for &k in self.neighbours(old) {
+                let mut r = position[k];
+                if r > i {
+                    continue;
+                }
+                while ancestor[r] != usize::MAX && ancestor[r] != i {
+                    let next = ancestor[r];
+                    ancestor[r] = i;
+                    r = next;
+                }
+                if ancestor[r] == usize::MAX {
+                    ancestor[r] = i;
+                    parent[r] = i;
+                }
+            }
+        }
+        parent
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::CscMatrix;
+    use faer::sparse::linalg::cholesky::simplicial::prefactorize_symbolic_cholesky;
+
+    /// A symmetric matrix on `widths.len()` nodes of the given widths, full blocks on the
+    /// diagonal and between the nodes of each edge.
+    fn blocked(widths: &[usize], edges: &[(usize, usize)]) -> CscMatrix {
+        let mut start = vec![0];
+        for w in widths {
+            start.push(start.last().unwrap() + w);
+        }
+        let mut t = Vec::new();
+        let block = |t: &mut Vec<(usize, usize, f64)>, g: usize, h: usize| {
+            for r in start[g]..start[g + 1] {
+                for c in start[h]..start[h + 1] {
+                    t.push((r, c, if r == c { 10.0 } else { -0.1 }));
+                }
+            }
+        };
+        for g in 0..widths.len() {
+            block(&mut t, g, g);
+        }
+        for &(g, h) in edges {
+            block(&mut t, g, h);
+            block(&mut t, h, g);
+        }
+        let n = *start.last().unwrap();
+        CscMatrix::from_triplets(n, n, &t).unwrap()
+    }
+
+    /// A scattered graph: a ring of `m` nodes with chords from a fixed-seed LCG, widths 1–6.
+    fn scattered(m: usize) -> CscMatrix {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as usize
+        };
+        let widths: Vec<usize> = (0..m).map(|_| 1 + next() % 6).collect();
+        let mut edges: Vec<(usize, usize)> = (0..m).map(|g| (g, (g + 1) % m)).collect();
+        for _ in 0..m {
+            let (g, h) = (next() % m, next() % m);
+            if g != h {
+                edges.push((g, h));
+            }
+        }
+        blocked(&widths, &edges)
+    }
+
+    /// nnz(L) and Σ c² of the scalar factor under `p`, by faer's own column counts.
+    fn scalar_fill(a: &CscMatrix, p: &Permutation) -> FillEstimate {
+        let a = a.as_ref();
+        let n = a.ncols();
+        let mut t = Vec::new();
+        for j in 0..n {
+            for &i in a.col(j).0 {
+                let (pi, pj) = (p.inv[i], p.inv[j]);
+                if pi <= pj {
+                    t.push((pi, pj, 1.0));
+                }
+            }
+        }
+        let upper = CscMatrix::from_triplets(n, n, &t).unwrap();
+        let u = upper.as_ref();
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, u.col_ptr(), None, u.row_idx());
+        let mut etree = vec![0isize; n];
+        let mut counts = vec![0usize; n];
+        let mut buf = MemBuffer::new(faer::dyn_stack::StackReq::new::<usize>(n));
+        prefactorize_symbolic_cholesky(&mut etree, &mut counts, pattern, MemStack::new(&mut buf));
+        FillEstimate {
+            nnz_l: counts.iter().sum(),
+            flops: counts.iter().map(|&c| (c * c) as f64).sum(),
+        }
+    }
+
+    #[test]
+    fn nodes_are_the_blocks() {
+        let a = blocked(&[6, 3, 6, 1], &[(0, 1), (1, 2), (2, 3)]);
+        let g = NodeGraph::of(a.as_ref()).unwrap();
+        assert_eq!(g.nodes(), 4);
+        assert_eq!(
+            (0..4).map(|k| g.weight(k)).collect::<Vec<_>>(),
+            [6, 3, 6, 1]
+        );
+        assert_eq!(g.neighbours(1), [0, 2]);
+        assert_eq!(g.edges(), 6);
+    }
+
+    /// The fill predicted on the node graph is faer's scalar column count exactly, for node
+    /// orders from AMD, nested dissection, the identity and its reverse.
+    #[test]
+    fn predicted_fill_is_the_scalar_factors() {
+        for m in [1, 2, 17, 200] {
+            let a = scattered(m);
+            let g = NodeGraph::of(a.as_ref()).unwrap();
+            let k = g.nodes();
+            let mut orders = vec![(0..k).collect::<Vec<_>>(), (0..k).rev().collect()];
+            orders.push(g.amd().unwrap());
+            if cfg!(feature = "metis") {
+                orders.push(g.nested_dissection().unwrap());
+            }
+            for nodes in orders {
+                let p = g.expand(&nodes).unwrap();
+                assert_eq!(g.fill(&nodes), scalar_fill(&a, &p), "m = {m}");
+            }
+        }
+    }
+
+    /// Auto is the candidate with fewer predicted flops, its fill the prediction.
+    #[test]
+    fn auto_takes_the_cheaper_candidate() {
+        let a = scattered(300);
+        let g = NodeGraph::of(a.as_ref()).unwrap();
+        let (p, fill, chosen) = g.order(&FillOrdering::Auto).unwrap();
+        let amd = g.order(&FillOrdering::Amd).unwrap().1;
+        let mut best = amd.flops;
+        if cfg!(feature = "metis") {
+            best = best.min(g.order(&FillOrdering::NestedDissection).unwrap().1.flops);
+        } else {
+            assert_eq!(chosen, FillOrdering::Amd);
+        }
+        assert_eq!(fill.flops, best);
+        assert_eq!(scalar_fill(&a, &p), fill);
+    }
+
+    #[test]
+    fn an_asymmetric_pattern_is_refused() {
+        let a = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (1, 1, 1.0), (1, 0, 1.0)]).unwrap();
+        assert!(matches!(
+            NodeGraph::of(a.as_ref()),
+            Err(SolverError::NotStructurallySymmetric { .. })
+        ));
+    }
+}
