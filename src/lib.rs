@@ -22,6 +22,7 @@
 pub mod assembly;
 pub mod bench;
 pub mod cell;
+pub mod check;
 pub mod constraints;
 pub mod contact;
 pub mod element;

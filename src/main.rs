@@ -238,6 +238,26 @@ enum Command {
         #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
     },
+    /// Property checks of a model: symmetry, definiteness and conditioning of the system its
+    /// job solves, a cell's null space before its anchor (the three translations) and, for a
+    /// cell with contacts, the penalty study of its moduli (ABD at p, 10p, 100p, the limit
+    /// p → ∞ and the penalty an accuracy needs). Exit code 1 when a check fails.
+    Check {
+        /// Model file.
+        model: PathBuf,
+        #[command(flatten)]
+        solver: SolverArgs,
+        /// Print one JSON document instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Relative accuracy required of the moduli: a larger penalty error at the model's
+        /// penalties fails the check (without it the study reports the penalty for 1 %).
+        #[arg(long)]
+        accuracy: Option<f64>,
+        /// Skip the penalty study (three more homogenizations).
+        #[arg(long)]
+        no_penalty_study: bool,
+    },
 }
 
 #[derive(Subcommand)]
@@ -1152,6 +1172,92 @@ fn export_matrix(model_path: &Path, out: &Path) -> Result<(), Error> {
     io::write_job_system(&job, model_path, out).map(|_| ())
 }
 
+fn check(
+    model_path: &Path,
+    options: &fibercell::check::CheckOptions,
+    json: bool,
+) -> Result<(), Error> {
+    if !(options.accuracy > 0.0 && options.accuracy < 1.0) {
+        return Err(Error::InvalidOption(format!(
+            "--accuracy {} must lie in (0, 1): it is a relative error",
+            options.accuracy
+        )));
+    }
+    let model = io::load_model(model_path)?;
+    let report = fibercell::check::check_model(&model, options)?;
+    if json {
+        println!("{}", to_pretty(&report)?);
+    } else {
+        print_check(model_path, &report);
+    }
+    let failed: Vec<String> = report
+        .checks
+        .iter()
+        .filter(|c| !c.passed)
+        .map(|c| format!("{}: {}", c.name, c.value))
+        .collect();
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(Error::ChecksFailed { failed })
+    }
+}
+
+fn print_check(model_path: &Path, r: &fibercell::check::CheckReport) {
+    println!(
+        "{}: {} (n = {}, nnz = {})",
+        model_path.display(),
+        r.system,
+        r.matrix.n,
+        r.matrix.nnz
+    );
+    if let Some(p) = &r.penalty {
+        println!(
+            "penalty study (penalty_scale {} × 1, 10, 100; limit: A∞ − C/(s + a) through the three):",
+            p.model_scale
+        );
+        println!(
+            "  {:<4} {:>12} {:>12} {:>12} {:>12} {:>9} {:>7} {:>9}",
+            "", "×1", "×10", "×100", "limit", "±", "ratio", "error ×1"
+        );
+        for e in &p.entries {
+            println!(
+                "  {:<4} {:>12.5e} {:>12.5e} {:>12.5e} {:>12.5e} {:>9.1e} {:>7.2} {:>9.2e}",
+                e.name,
+                e.values[0],
+                e.values[1],
+                e.values[2],
+                e.limit,
+                e.limit_error,
+                e.convergence_ratio,
+                e.error_at_model
+            );
+        }
+        println!(
+            "  {:<4} {:>12.1e} {:>12.1e} {:>12.1e}   (round-off: ABD's asymmetry)",
+            "rnd", p.roundoff[0], p.roundoff[1], p.roundoff[2]
+        );
+        if let Some(r) = p.recommended_penalty_scale {
+            println!(
+                "  for a relative error of {:.0e}: penalty_scale = {r:.3e} in [contact]",
+                p.accuracy
+            );
+        }
+        for w in &p.warnings {
+            println!("  warning: {w}");
+        }
+    }
+    for c in &r.checks {
+        println!(
+            "{} {:<28} {}   [{}]",
+            if c.passed { "ok  " } else { "FAIL" },
+            c.name,
+            c.value,
+            c.limit
+        );
+    }
+}
+
 fn main() -> ExitCode {
     // Output piped into `head` and closed early ends the program quietly, as for any Unix
     // tool, instead of a panic in println!.
@@ -1232,6 +1338,22 @@ fn main() -> ExitCode {
             convert(&input, &output, &opts)
         }
         Command::ExportMatrix { model, output } => export_matrix(&model, &output),
+        Command::Check {
+            model,
+            solver,
+            json,
+            accuracy,
+            no_penalty_study,
+        } => check(
+            &model,
+            &fibercell::check::CheckOptions {
+                solve: solver.options(),
+                penalty_study: !no_penalty_study,
+                accuracy: accuracy.unwrap_or(1e-2),
+                require_accuracy: accuracy.is_some(),
+            },
+            json,
+        ),
         Command::SolveMatrix {
             matrix,
             rhs,

@@ -44,8 +44,14 @@ impl Discretization {
     }
 
     /// A periodic cell driven by the macroscopic strain `target` (reached at α = 1); the
-    /// translations of `anchor` are fixed.
-    pub fn periodic(model: &Model, p: &Periodicity, target: &MacroStrain, anchor: usize) -> Self {
+    /// translations of `anchor` are fixed (without one the system keeps the three rigid
+    /// translations as its null space: `fibercell check` verifies that).
+    pub fn periodic(
+        model: &Model,
+        p: &Periodicity,
+        target: &MacroStrain,
+        anchor: Option<usize>,
+    ) -> Self {
         let n = model.nodes.len();
         let g = &p.geometry;
         let mut fixed = vec![false; 6 * (n + 1)];
@@ -61,7 +67,9 @@ impl Discretization {
             }
         }
         for d in 0..3 {
-            fixed[6 * anchor + d] = true;
+            if let Some(a) = anchor {
+                fixed[6 * a + d] = true;
+            }
         }
         for k in 0..6 {
             fixed[6 * n + k] = true;

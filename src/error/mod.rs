@@ -74,6 +74,12 @@ pub enum Error {
         /// The largest applied load or prescribed value.
         largest: f64,
     },
+    /// `fibercell check` measured a property outside its limit.
+    #[error("{} check{} failed: {}", failed.len(), if failed.len() == 1 { "" } else { "s" }, failed.join("; "))]
+    ChecksFailed {
+        /// Each failed check with what was measured.
+        failed: Vec<String>,
+    },
     /// Writing an output failed.
     #[error("cannot write {path}: {message}")]
     Output {

@@ -166,7 +166,7 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
     // The cell is set up once: pairing, contacts, percolation through the closed contacts (the
     // all-stick system must hold together) and the anchor.
     let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, true)?;
-    let disc = Discretization::periodic(model, &p, &opts.strain, anchor);
+    let disc = Discretization::periodic(model, &p, &opts.strain, Some(anchor));
     let n = opts.steps;
     let mut path: Vec<f64> = (1..=n).map(|k| k as f64 / n as f64).collect();
     if opts.unload {

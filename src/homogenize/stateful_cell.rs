@@ -122,7 +122,7 @@ impl Cell {
                     .into(),
             ));
         }
-        let disc = Discretization::periodic(model, &periodicity, &[0.0; 6], anchor);
+        let disc = Discretization::periodic(model, &periodicity, &[0.0; 6], Some(anchor));
         let options = IncrementalOptions {
             steps: 1,
             path: None,

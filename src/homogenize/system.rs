@@ -190,6 +190,17 @@ impl PeriodicSystem {
     /// Pairs the boundary, finds the contacts, checks percolation, numbers the unknowns and
     /// builds the pattern.
     pub fn new(model: &Model) -> Result<Self, Error> {
+        Self::build(model, true)
+    }
+
+    /// [`PeriodicSystem::new`] without the anchor: the translations of every node are
+    /// unknowns, so the matrix is singular with the three rigid translations as its null
+    /// space (what [`crate::check`] verifies).
+    pub fn unanchored(model: &Model) -> Result<Self, Error> {
+        Self::build(model, false)
+    }
+
+    fn build(model: &Model, anchored: bool) -> Result<Self, Error> {
         let clock = std::time::Instant::now();
         let (periodicity, set, anchor) = prepare_cell(model, true)?;
         let mut timings = SetupTimings {
@@ -200,7 +211,8 @@ impl PeriodicSystem {
         let closed: Vec<usize> = (0..set.pairs.len())
             .filter(|&i| set.pairs[i].gap <= 0.0)
             .collect();
-        let discretization = Discretization::periodic(model, &periodicity, &[0.0; 6], anchor);
+        let discretization =
+            Discretization::periodic(model, &periodicity, &[0.0; 6], anchored.then_some(anchor));
         let elements = ElementBlocks::new(model, &discretization);
         let contacts: Vec<ContactPair> = closed
             .iter()

@@ -49,7 +49,9 @@ mod tests {
     use std::path::Path;
 
     /// A supported model's job system, solved, gives `solve_static`'s displacements row by row
-    /// (1e-12); a cell's has six right-hand sides, one per macroscopic strain.
+    /// to 1e-9 of the largest: two solves of the same system agree to κ₁ε ≈ 7e-10 at most
+    /// (κ₁ = 3.3e6 by `fibercell check`; measured 2.8e-12); a cell's has six right-hand sides,
+    /// one per macroscopic strain.
     #[test]
     fn the_job_system_is_what_the_jobs_solve() {
         let model = crate::io::load_model(Path::new("fixtures/ok_frame3d.toml")).unwrap();
@@ -66,7 +68,7 @@ mod tests {
         for (k, &(node, dof)) in sys.dofs.iter().enumerate() {
             let want = reference.displacements[model.node_index(node).unwrap()][dof.index()];
             assert!(
-                (x[k] - want).abs() <= 1e-12 * scale,
+                (x[k] - want).abs() <= 1e-9 * scale,
                 "row {k}: {} against {want}",
                 x[k]
             );

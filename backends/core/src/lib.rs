@@ -20,6 +20,7 @@
 //! [`SolverError::Unavailable`] and a backend's automatic choice is AMD) and `sprs` (the
 //! conversions to and from sprs matrices).
 
+mod condition;
 mod csc;
 mod error;
 mod factor_pcg;
@@ -30,6 +31,7 @@ mod ordering;
 mod residual;
 mod solver;
 
+pub use condition::{inverse_norm1_estimate, norm1, SolveWith};
 pub use csc::{CscMatrix, CscRef, PatternFingerprint};
 pub use error::{SolverError, StopReason};
 pub use factor_pcg::{pcg_with_factor, FactorPcg};

@@ -127,63 +127,12 @@ impl FaerLu {
         })
     }
 
-    /// An estimate of ‖A⁻¹‖₁ from the current factorization (Higham 1988, Algorithm 4.1, as
-    /// LAPACK's `dlacn2`): a lower bound that is almost always within a factor 3, from at most
-    /// five pairs of solves with A and Aᵀ and one more with an alternating vector. Infinite
-    /// when a solve is not finite.
+    /// An estimate of ‖A⁻¹‖₁ from the current factorization
+    /// ([`fibercell_solver::inverse_norm1_estimate`]).
     fn inverse_norm1_estimate(&self, n: usize) -> Result<f64, SolverError> {
-        let norm1 = |v: &[f64]| v.iter().map(|x| x.abs()).sum::<f64>();
-        let mut x = vec![1.0 / n as f64; n];
-        let mut estimate = 0.0f64;
-        let mut last_j = usize::MAX;
-        for iteration in 0..5 {
-            self.solve_raw(&mut x, 1)?;
-            if x.iter().any(|v| !v.is_finite()) {
-                return Ok(f64::INFINITY);
-            }
-            let y_norm = norm1(&x);
-            if iteration > 0 && y_norm <= estimate {
-                break;
-            }
-            estimate = y_norm;
-            let mut z: Vec<f64> = x
-                .iter()
-                .map(|v| if *v >= 0.0 { 1.0 } else { -1.0 })
-                .collect();
-            self.solve_raw_with(&mut z, 1, true)?;
-            let (j, zj) = z
-                .iter()
-                .enumerate()
-                .fold((0, f64::NEG_INFINITY), |m, (k, v)| {
-                    if v.abs() > m.1 {
-                        (k, v.abs())
-                    } else {
-                        m
-                    }
-                });
-            if !zj.is_finite() {
-                return Ok(f64::INFINITY);
-            }
-            if j == last_j {
-                break;
-            }
-            last_j = j;
-            x.iter_mut().for_each(|v| *v = 0.0);
-            x[j] = 1.0;
-        }
-        // The alternating vector catches matrices where the iteration stalls.
-        let mut alt: Vec<f64> = (0..n)
-            .map(|i| {
-                let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
-                sign * (1.0 + i as f64 / (n.max(2) - 1) as f64)
-            })
-            .collect();
-        self.solve_raw(&mut alt, 1)?;
-        let alt_estimate = 2.0 * norm1(&alt) / (3.0 * n as f64);
-        if !alt_estimate.is_finite() {
-            return Ok(f64::INFINITY);
-        }
-        Ok(estimate.max(alt_estimate))
+        fibercell_solver::inverse_norm1_estimate(n, &mut |x, transposed| {
+            self.solve_raw_with(x, 1, transposed)
+        })
     }
 }
 
