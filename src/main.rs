@@ -88,6 +88,10 @@ enum Command {
         /// the per-contact return mapping.
         #[arg(long)]
         fixed_slip_direction: bool,
+        /// Print one line per increment on stderr (models with contact): state iterations,
+        /// factorizations, low-rank solves and their sizes, cutbacks, contact states, time.
+        #[arg(long)]
+        log: bool,
         #[command(flatten)]
         output: OutDir,
         #[command(flatten)]
@@ -146,6 +150,10 @@ enum Command {
         /// so fibers that lose their hold do not make the system singular.
         #[arg(long, default_value_t = 0.0)]
         stabilization: f64,
+        /// Print one line per increment on stderr: state iterations, factorizations, low-rank
+        /// solves and their sizes, cutbacks, contact states, time.
+        #[arg(long)]
+        log: bool,
     },
     /// Generate a periodic fabric cell and print its statistics.
     Generate {
@@ -547,8 +555,10 @@ fn write(path: &Path, contents: &str) -> Result<(), Error> {
     io::write_atomic(path, contents.as_bytes())
 }
 
-/// A progress bar on stderr for runs of many increments (hidden when stderr is not a terminal).
-fn progress_bar(what: &str) -> (indicatif::ProgressBar, fibercell::solve::Progress) {
+/// A progress bar on stderr for runs of many increments (hidden when stderr is not a terminal);
+/// with `log`, also one line per increment: its iterations, factorizations, low-rank solves
+/// and their largest capacitance order, the crossover order, cutbacks, sliding contacts, time.
+fn progress_bar(what: &str, log: bool) -> (indicatif::ProgressBar, fibercell::solve::Progress) {
     let bar = indicatif::ProgressBar::new(0);
     if let Ok(style) =
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} increments ({eta})")
@@ -557,11 +567,45 @@ fn progress_bar(what: &str) -> (indicatif::ProgressBar, fibercell::solve::Progre
     }
     bar.set_message(what.to_string());
     let b = bar.clone();
-    let report = fibercell::solve::Progress(std::sync::Arc::new(move |done, total| {
+    let report = fibercell::solve::Progress(std::sync::Arc::new(move |done, total, r| {
         b.set_length(total as u64);
         b.set_position(done as u64);
+        if log {
+            let line = increment_log_line(done, total, r);
+            if b.is_hidden() {
+                eprintln!("{line}");
+            } else {
+                b.println(line);
+            }
+        }
     }));
     (bar, report)
+}
+
+/// One increment in the `--log` of `curve` and `solve`.
+fn increment_log_line(done: usize, total: usize, r: &fibercell::solve::IncrementRecord) -> String {
+    let crossover = r
+        .low_rank
+        .crossover_order
+        .map_or_else(|| "-".to_string(), |c| c.to_string());
+    format!(
+        "increment {done}/{total} α={:.4}: {} iterations, {} factorizations, {} low-rank solves \
+         (largest order {}, crossover {crossover}, {} columns kept), {} cutbacks, \
+         open/stick/slip {}/{}/{}, held {}, residual {:.1e}, {:.2} s",
+        r.alpha,
+        r.iterations,
+        r.factorizations,
+        r.factor_reuses,
+        r.low_rank.largest_order,
+        r.low_rank.columns,
+        r.cutbacks,
+        r.open,
+        r.stick,
+        r.slip,
+        r.held,
+        r.equilibrium_residual,
+        r.seconds
+    )
 }
 
 fn to_pretty<T: serde::Serialize>(doc: &T) -> Result<String, Error> {
@@ -574,7 +618,7 @@ fn to_pretty<T: serde::Serialize>(doc: &T) -> Result<String, Error> {
 fn solve(
     model_path: &Path,
     options: SolveOptions,
-    incremental: (usize, bool),
+    incremental: (usize, bool, bool),
     json: bool,
     (out, vtk): (&Path, io::VtkEncoding),
 ) -> Result<(), Error> {
@@ -643,11 +687,11 @@ fn solve_with_contact(
     model_path: &Path,
     model: &fibercell::Model,
     solve: SolveOptions,
-    (steps, fixed_slip_direction): (usize, bool),
+    (steps, fixed_slip_direction, log): (usize, bool, bool),
     json: bool,
     (out, vtk): (&Path, io::VtkEncoding),
 ) -> Result<(), Error> {
-    let (bar, progress) = progress_bar("stick/slip");
+    let (bar, progress) = progress_bar("stick/slip", log);
     let opts = IncrementalOptions {
         steps,
         solve,
@@ -807,14 +851,14 @@ fn curve(
     model_path: &Path,
     (strain, steps, unload): (fibercell::cell::MacroStrain, usize, bool),
     (solve, bonded, stabilization): (SolveOptions, bool, f64),
-    json: bool,
+    (json, log): (bool, bool),
     out: &Path,
 ) -> Result<(), Error> {
     use fibercell::homogenize::{elasto_plastic_curve, CurveOptions};
     let model = io::load_model(model_path)?;
     // curve.json is written last: a folder that holds it is complete.
     io::begin_results(out, "curve.json")?;
-    let (bar, progress) = progress_bar("curve");
+    let (bar, progress) = progress_bar("curve", log);
     let incremental = IncrementalOptions {
         progress: Some(progress),
         bonded,
@@ -1280,13 +1324,14 @@ fn main() -> ExitCode {
             solver,
             steps,
             fixed_slip_direction,
+            log,
             json,
             output,
             vtk,
         } => solve(
             &model,
             solver.options(),
-            (steps, fixed_slip_direction),
+            (steps, fixed_slip_direction, log),
             json,
             (&output.dir, vtk.encoding),
         ),
@@ -1312,11 +1357,12 @@ fn main() -> ExitCode {
             output,
             bonded,
             stabilization,
+            log,
         } => curve(
             &model,
             (strain, steps, unload),
             (solver.options(), bonded, stabilization),
-            json,
+            (json, log),
             &output.dir,
         ),
         Command::Generate { kind } => generate(kind),

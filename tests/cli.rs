@@ -259,6 +259,43 @@ fn homogenize_prints_abd_and_writes_the_cell_problems() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("no [cell] section"));
 }
 
+/// Checks `curve --log`'s stderr: one line per increment, with the counts `curve.json`
+/// records for it.
+fn check_increment_log(stderr: &str, points: &[serde_json::Value]) {
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("increment "))
+        .collect();
+    assert_eq!(lines.len(), points.len(), "{stderr}");
+    let n = points.len();
+    for (k, (line, p)) in lines.iter().zip(points).enumerate() {
+        assert!(
+            line.starts_with(&format!("increment {}/{n} ", k + 1)),
+            "{line}"
+        );
+        let rest = &line[line.find(": ").unwrap() + 2..];
+        let iterations: u64 = rest.split(' ').next().unwrap().parse().unwrap();
+        assert_eq!(iterations, p["iterations"].as_u64().unwrap(), "{line}");
+        let counts: Vec<u64> = line
+            .split("open/stick/slip ")
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .split('/')
+            .map(|c| c.parse().unwrap())
+            .collect();
+        let expected: Vec<u64> = ["open", "stick", "slip"]
+            .iter()
+            .map(|s| p[*s].as_u64().unwrap())
+            .collect();
+        assert_eq!(counts, expected, "{line}");
+        assert!(line.contains(" factorizations, ") && line.contains(" low-rank solves "));
+    }
+}
+
+/// `curve` writes its files; with `--log` it prints one line per increment on stderr.
 #[test]
 fn curve_writes_csv_switches_json_svg_and_png() {
     let out = tmpdir("curve");
@@ -270,6 +307,7 @@ fn curve_writes_csv_switches_json_svg_and_png() {
         "--steps",
         "20",
         "--unload",
+        "--log",
         "-o",
         out.to_str().unwrap(),
     ]);
@@ -285,6 +323,10 @@ fn curve_writes_csv_switches_json_svg_and_png() {
     let doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("curve.json")).unwrap()).unwrap();
     assert_eq!(doc["points"].as_array().unwrap().len(), 60);
+    check_increment_log(
+        &String::from_utf8_lossy(&o.stderr),
+        doc["points"].as_array().unwrap(),
+    );
     for (args, needle) in [
         (
             vec![

@@ -425,9 +425,9 @@ fn progress_is_reported_after_every_increment() {
     let m = io::load_model(Path::new("fixtures/ok_contact_bars2.toml")).unwrap();
     let opts = IncrementalOptions {
         steps: 3,
-        progress: Some(fibercell::solve::Progress(Arc::new(move |done, total| {
-            log.lock().unwrap().push((done, total))
-        }))),
+        progress: Some(fibercell::solve::Progress(Arc::new(
+            move |done, total, _| log.lock().unwrap().push((done, total)),
+        ))),
         ..Default::default()
     };
     solve_incremental(&m, &opts).unwrap();

@@ -18,7 +18,7 @@ pub use increment_timings::IncrementTimings;
 pub(crate) use incremental::{run_incremental, Advanced, OnAllStick, RunState, Setup};
 pub use incremental::{
     solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
-    IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, BOUND_TOLERANCE,
+    IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, ProgressFn, BOUND_TOLERANCE,
     EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS,
     MAX_LOW_RANK_COLUMNS,
 };

@@ -48,8 +48,8 @@ mod stabilizer;
 
 pub use driver_couplings::DriverCouplings;
 pub use options::{
-    IncrementalOptions, Progress, BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS,
-    MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
+    IncrementalOptions, Progress, ProgressFn, BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE,
+    MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
 };
 pub use records::{
     ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
@@ -131,8 +131,8 @@ pub(crate) fn run_incremental(
     for (step, &alpha) in (1..).zip(&path) {
         solver.advance(step, (from, alpha), 0)?;
         from = alpha;
-        if let Some(p) = &opts.progress {
-            (p.0)(step, path.len());
+        if let (Some(p), Some(record)) = (&opts.progress, solver.out.increments.last()) {
+            (p.0)(step, path.len(), record);
         }
         if opts
             .deadline

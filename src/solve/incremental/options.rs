@@ -3,9 +3,13 @@
 
 use super::super::SolveOptions;
 
-/// A callback told after every increment: (increments done, increments in all).
+/// A callback told after every increment: (increments done, increments in all, the record of
+/// the increment just done: its iterations, factorizations, low-rank sizes, cutbacks, times).
 #[derive(Clone)]
-pub struct Progress(pub std::sync::Arc<dyn Fn(usize, usize) + Send + Sync>);
+pub struct Progress(pub std::sync::Arc<ProgressFn>);
+
+/// The function a [`Progress`] calls.
+pub type ProgressFn = dyn Fn(usize, usize, &super::IncrementRecord) + Send + Sync;
 
 impl std::fmt::Debug for Progress {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -59,9 +63,10 @@ pub struct IncrementalOptions {
     /// (default [`MAX_LOW_RANK_COLUMNS`], 512 MB).
     pub max_low_rank_columns: usize,
     /// A state iteration whose capacitance matrix is larger than this factorizes its matrix
-    /// directly instead (the reference stays for the iterations after); `None` (default):
-    /// decided by the measured costs, a low-rank solve while its capacitance factorization is
-    /// predicted cheaper than a factorization. A bound makes the choice independent of the
+    /// directly instead, as the new reference; `None` (default): decided by the measured
+    /// costs, a low-rank solve while its capacitance factorization is predicted cheaper than
+    /// a factorization, and a new reference once the capacitance factorizations on the
+    /// current one have cost a factorization. A bound makes the choice independent of the
     /// machine's timings.
     pub max_capacitance_order: Option<usize>,
     /// Stop after the increment during which this instant passes (default: none); the solution
