@@ -2,7 +2,10 @@
 //! contacts held, and the contacts whose state, slip direction, sliding force or Coulomb bound
 //! the solve did not match.
 
-use super::options::{BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE, SETTLE_BY_EQUILIBRIUM_AFTER};
+use super::options::{
+    BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE, SETTLE_BY_EQUILIBRIUM_AFTER,
+    STALLED_EQUILIBRIUM_TOLERANCE,
+};
 use super::return_mapping::{classify, gather, hold, unsettled_force, Trial};
 use super::StickSlip;
 use crate::contact::ContactState;
@@ -17,22 +20,54 @@ pub(super) struct Classified {
     pub forces_only: bool,
 }
 
+/// The strict equilibrium residuals of an increment's settled-looking state iterations, to
+/// tell a fixed point still converging from one at its round-off floor.
+#[derive(Default)]
+pub(super) struct ResidualFloor {
+    seen: Vec<(usize, f64)>,
+}
+
+impl ResidualFloor {
+    /// Records the residual `r` of state iteration `iteration`; whether it stalled there: at
+    /// most [`STALLED_EQUILIBRIUM_TOLERANCE`] and not below half the smaller of the two
+    /// iterations before (both recorded).
+    fn stalled(&mut self, iteration: usize, r: f64) -> bool {
+        let before: Vec<f64> = self
+            .seen
+            .iter()
+            .filter(|(i, _)| *i + 2 >= iteration && *i < iteration)
+            .map(|(_, v)| *v)
+            .collect();
+        self.seen.push((iteration, r));
+        let distinct = |k: usize| self.seen.iter().any(|(i, _)| *i + k == iteration);
+        let best = before.iter().copied().fold(f64::INFINITY, f64::min);
+        distinct(1) && distinct(2) && r <= STALLED_EQUILIBRIUM_TOLERANCE && r >= 0.5 * best
+    }
+}
+
 impl StickSlip<'_, '_, '_> {
     /// [`StickSlip::classify`], with the changes dropped when, from state iteration
     /// [`SETTLE_BY_EQUILIBRIUM_AFTER`] on, they only say that sliding forces are off the law
     /// (no state, slip direction or sign of N moved) while the increment to load factor
-    /// `alpha` is in equilibrium with the law's forces to [`EQUILIBRIUM_TOLERANCE`]: the
-    /// displacements are then a solution, whatever the linearization still says (on large
-    /// cells the per-contact test asks the tangential displacements for more digits than the
-    /// solves carry).
-    pub(super) fn classify_settled(&self, alpha: f64, iteration: usize) -> Classified {
+    /// `alpha` is in equilibrium with the law's forces to [`EQUILIBRIUM_TOLERANCE`], or its
+    /// residual stalled within twice that (`floor`): the displacements are then a solution,
+    /// whatever the linearization still says (on large cells the per-contact test asks the
+    /// tangential displacements for more digits than the solves carry).
+    pub(super) fn classify_settled(
+        &self,
+        alpha: f64,
+        iteration: usize,
+        floor: &mut ResidualFloor,
+    ) -> Classified {
         let mut classified = self.classify();
         if iteration >= SETTLE_BY_EQUILIBRIUM_AFTER
             && !classified.changed.is_empty()
             && classified.forces_only
-            && self.equilibrium_residual(alpha, &classified.trials) <= EQUILIBRIUM_TOLERANCE
         {
-            classified.changed.clear();
+            let r = self.equilibrium_residual(alpha, &classified.trials);
+            if r <= EQUILIBRIUM_TOLERANCE || floor.stalled(iteration, r) {
+                classified.changed.clear();
+            }
         }
         classified
     }

@@ -50,13 +50,14 @@ pub use driver_couplings::DriverCouplings;
 pub use options::{
     IncrementalOptions, Progress, ProgressFn, BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE,
     MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
+    STALLED_EQUILIBRIUM_TOLERANCE,
 };
 pub use records::{
     ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
 };
 
 use assemble::System;
-use classify::Classified;
+use classify::{Classified, ResidualFloor};
 use commit::EnergyHistory;
 use contact_states::ContactStates;
 use factors::Factors;
@@ -238,10 +239,11 @@ impl<'s, 'a, 'h> StickSlip<'s, 'a, 'h> {
         self.contacts.acceleration.restart();
         self.contacts.predict_bounds(alpha);
         let max_iterations = self.setup.opts.max_state_iterations;
+        let mut floor = ResidualFloor::default();
         for iteration in 1..=max_iterations {
             let mut system = self.assemble(&mut inc)?;
             let solved = self.solve(&mut inc, &mut system, iteration)?;
-            let mut classified = self.classify_settled(alpha, iteration);
+            let mut classified = self.classify_settled(alpha, iteration, &mut floor);
             let mut report = solved.report;
             if let (true, Some(cap)) = (classified.changed.is_empty(), &solved.unchecked) {
                 inc.lap(|t| &mut t.classify);
@@ -252,7 +254,7 @@ impl<'s, 'a, 'h> StickSlip<'s, 'a, 'h> {
                 };
                 report = Some(checked);
                 if refined {
-                    classified = self.classify_settled(alpha, iteration);
+                    classified = self.classify_settled(alpha, iteration, &mut floor);
                 }
             }
             let Classified {
