@@ -134,3 +134,36 @@ impl StickSlip<'_, '_, '_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::ResidualFloor;
+
+    /// The strict residuals of the L non-woven's increment 93 under e22 (seed 2), iterations
+    /// 8–10, traced: a floor, settled at the third; a residual still falling by more than half
+    /// per iteration is not, nor one above 2·10⁻⁸, nor one without two iterations before it.
+    #[test]
+    fn a_floor_stalls_and_a_falling_residual_does_not() {
+        let mut floor = ResidualFloor::default();
+        assert!(!floor.stalled(8, 1.093e-8));
+        assert!(!floor.stalled(9, 1.091e-8));
+        assert!(floor.stalled(10, 1.050e-8));
+
+        let mut falling = ResidualFloor::default();
+        assert!(!falling.stalled(8, 1e-7));
+        assert!(!falling.stalled(9, 4e-8));
+        assert!(!falling.stalled(10, 1.5e-8));
+
+        let mut above = ResidualFloor::default();
+        for (i, r) in [(8, 3e-8), (9, 3e-8)] {
+            assert!(!above.stalled(i, r));
+        }
+        assert!(!above.stalled(10, 3e-8));
+
+        let mut gap = ResidualFloor::default();
+        assert!(!gap.stalled(8, 1.1e-8));
+        assert!(!gap.stalled(10, 1.1e-8));
+        assert!(!gap.stalled(11, 1.1e-8), "iteration 9 missing");
+        assert!(gap.stalled(12, 1.1e-8));
+    }
+}
