@@ -9,6 +9,10 @@ halved, the largest equilibrium residual and energy-balance error. Issue 28 poin
 completion with residual <= 1e-8.
 
     python3 benches/curve_matrix.py --presets S,M --seeds 1,2,3 -o benches/results/curve-matrix.json
+    python3 benches/curve_matrix.py --presets L --seeds 3 --loads g12 --merge -o benches/results/curve-matrix.json
+
+The table is rewritten after every run; with --merge the rows already in it stay, those of the
+same cell and load replaced.
 
 Standard library only; the binary is target/release/fibercell (build it first).
 """
@@ -69,6 +73,23 @@ def summarize(curve):
     }
 
 
+def merged(kept, rows):
+    """kept's rows in their order with those of the same cell and load replaced by rows',
+    then rows' new ones."""
+    new = {(r["cell"], r["load"]): r for r in rows}
+    out = [new.pop((r["cell"], r["load"]), r) for r in kept]
+    return out + [r for r in rows if (r["cell"], r["load"]) in new]
+
+
+def write_table(path, binary, rows):
+    """Writes the table whole or not at all (a temporary file renamed over path), so a run
+    stopped midway leaves the rows finished so far."""
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump({"binary": binary, "rows": rows}, f, indent=1)
+    os.replace(tmp, path)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--presets", default="S,M", help="non-woven presets, comma-separated (S,M,L)")
@@ -76,7 +97,12 @@ def main():
     ap.add_argument("--loads", default=",".join(LOADS), help="subset of " + ",".join(LOADS))
     ap.add_argument("--other-cells", action="store_true", help="also the woven, knitted and geotextile cells")
     ap.add_argument("--binary", default="target/release/fibercell")
-    ap.add_argument("-o", "--output", help="JSON file for the table (written at the end)")
+    ap.add_argument("-o", "--output", help="JSON file for the table (rewritten after every run)")
+    ap.add_argument(
+        "--merge",
+        action="store_true",
+        help="keep the rows of an existing --output file, replacing those of the same cell and load",
+    )
     args = ap.parse_args()
 
     cells = []
@@ -86,6 +112,10 @@ def main():
     if args.other_cells:
         cells += list(OTHER_CELLS.items())
 
+    kept = []
+    if args.merge and args.output and os.path.exists(args.output):
+        with open(args.output) as f:
+            kept = json.load(f)["rows"]
     rows = []
     failed = 0
     with tempfile.TemporaryDirectory() as work:
@@ -107,10 +137,9 @@ def main():
                 failed += not ok
                 rows.append(row)
                 print(json.dumps(row), flush=True)
+                if args.output:
+                    write_table(args.output, args.binary, merged(kept, rows))
 
-    if args.output:
-        with open(args.output, "w") as f:
-            json.dump({"binary": args.binary, "rows": rows}, f, indent=1)
     print(f"{len(rows) - failed} within 1e-8, {failed} not")
     sys.exit(1 if failed else 0)
 
