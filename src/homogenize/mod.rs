@@ -9,6 +9,7 @@ mod orthotropic;
 mod pressure;
 mod segments;
 mod stateful_cell;
+mod stick_system;
 pub(crate) mod system;
 
 pub use curve::{
@@ -22,4 +23,5 @@ pub use orthotropic::{Orthotropic, ThesisModuli};
 pub use pressure::{default_pixel, pressure_load, PressureLoad};
 pub use segments::{segment_starting_at, Segment};
 pub use stateful_cell::{Cell, CellResponse, CellState};
-pub use system::{ContactStiffness, PeriodicSystem, PeriodicValues, SetupTimings};
+pub use stick_system::{ContactStiffness, PeriodicValues, StickSystem};
+pub use system::{PeriodicSystem, SetupTimings};

@@ -6,109 +6,13 @@
 //! (K_N + K_T^st, plus the rolling resistance K_R): the elastic moduli A^elas of thesis (5.5).
 //! Contacts are searched with the periodic images, so crossings on the boundary count.
 
-use crate::assembly::{color_blocks, ContactColumns, ElementBlocks, Pattern, SharedMut, NO_SLOT};
-use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, MacroStrain, Periodicity};
+use super::stick_system::StickSystem;
+use crate::cell::{anchor_node, check_percolation, pair_boundary_nodes, Periodicity};
 use crate::constraints::Discretization;
-use crate::contact::{ContactPair, ContactSet, ContactSide};
-use crate::model::{Dof, Model};
-use crate::solve::DriverCouplings;
+use crate::contact::{ContactSet, ContactSide};
+use crate::model::Model;
 use crate::Error;
-use fibercell_solver::{CscMatrix, SolverError};
-use nalgebra::SMatrix;
-use rayon::prelude::*;
-
-/// The assembled values of a periodic cell problem.
-#[derive(Clone, Debug)]
-pub struct PeriodicValues {
-    /// Values of K_ff on the pattern.
-    pub values: Vec<f64>,
-    /// K_fE and K_EE.
-    pub couplings: DriverCouplings,
-}
-
-type Matrix6 = SMatrix<f64, 6, 6>;
-
-/// Where the blocks of one color write: K_ff through the pattern, K_fE by free DOF; blocks of
-/// a color share no generalized node but the driver, so their writes are disjoint.
-struct Sink<'a> {
-    disc: &'a Discretization,
-    driver: usize,
-    values: SharedMut<'a, f64>,
-    coupling: SharedMut<'a, [f64; 6]>,
-}
-
-impl Sink<'_> {
-    /// Adds the m × m block `k(row, column)` on generalized nodes `gnodes` (m = 6 per node)
-    /// through its row-major pattern `slots`; returns its driver–driver part, if any.
-    fn add(
-        &self,
-        gnodes: &[usize],
-        k: impl Fn(usize, usize) -> f64,
-        slots: &[u32],
-    ) -> Option<Matrix6> {
-        let m = 6 * gnodes.len();
-        if !gnodes.contains(&self.driver) {
-            // No driver node (all blocks but a few): every entry goes to its slot, a node's six
-            // rows of a column as one run when they are adjacent slots (`Pattern::row_run`).
-            for c in 0..m {
-                for r0 in (0..m).step_by(6) {
-                    if let Some(first) = Pattern::row_run(slots, m, r0, c) {
-                        // SAFETY: as below, the slots couple two nodes of this block only.
-                        let run = unsafe { self.values.run::<6>(first as usize) };
-                        for (d, v) in run.iter_mut().enumerate() {
-                            *v += k(r0 + d, c);
-                        }
-                        continue;
-                    }
-                    for r in r0..r0 + 6 {
-                        let s = slots[r * m + c];
-                        if s != NO_SLOT {
-                            // SAFETY: as below, the slot couples two nodes of this block only.
-                            unsafe { *self.values.get(s as usize) += k(r, c) };
-                        }
-                    }
-                }
-            }
-            return None;
-        }
-        let mut k_ee: Option<Matrix6> = None;
-        let driver = |r: usize| gnodes[r / 6] == self.driver;
-        let mut put = |r: usize, c: usize, v: f64| match (driver(r), driver(c)) {
-            (true, true) => k_ee.get_or_insert_with(Matrix6::zeros)[(r % 6, c % 6)] += v,
-            (false, true) => {
-                if let Some(i) = self.disc.reduced(6 * gnodes[r / 6] + r % 6) {
-                    // SAFETY: row r's node is not the driver and belongs to this block only
-                    // within its color (see `PeriodicSystem::element_colors`).
-                    unsafe { self.coupling.get(i)[c % 6] += v };
-                }
-            }
-            (_, false) => {
-                let s = slots[r * m + c];
-                if s != NO_SLOT {
-                    // SAFETY: the slot couples two non-driver nodes of this block, which no
-                    // other block of its color holds.
-                    unsafe { *self.values.get(s as usize) += v };
-                }
-            }
-        };
-        // Column by column: a column's entries of one node are adjacent in K.
-        for c in 0..m {
-            for r in 0..m {
-                put(r, c, k(r, c));
-            }
-        }
-        k_ee
-    }
-}
-
-/// The tangential state a closed contact enters the cell matrix with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ContactStiffness {
-    /// K_N + K_T^st + K_R (the elastic moduli A^elas).
-    Stick,
-    /// K_N + K_R: no tangential stiffness (a contact sliding under a Tresca bound).
-    Sliding,
-}
+use std::ops::Deref;
 
 /// Wall-clock seconds of [`PeriodicSystem::new`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -121,26 +25,26 @@ pub struct SetupTimings {
     pub pattern: f64,
 }
 
-/// Numbering, pattern and block maps of a periodic cell.
+/// A periodic cell's system: its pairing and geometry, the anchor, and the
+/// [`StickSystem`] on the periodic discretization (reached through `Deref`).
 #[derive(Clone, Debug)]
 pub struct PeriodicSystem {
     /// Pairing and geometry.
     pub periodicity: Periodicity,
-    /// Unknowns and constraint maps (drivers prescribed to zero).
-    pub discretization: Discretization,
-    /// Sparsity pattern of K_ff: elements, then closed contacts.
-    pub pattern: Pattern,
-    /// Every element's block on the generalized nodes.
-    elements: ElementBlocks,
-    pub(crate) contacts: Vec<ContactPair>,
-    /// Elements by color: no two of a color share a generalized node other than the driver.
-    element_colors: Vec<Vec<usize>>,
-    /// Closed contacts by the nodes whose columns they fill.
-    pub(crate) contact_columns: ContactColumns,
+    /// The elements and closed contacts on the periodic discretization.
+    pub system: StickSystem,
     /// The node whose translations are fixed.
     pub anchor: usize,
     /// How long building it took.
     pub timings: SetupTimings,
+}
+
+impl Deref for PeriodicSystem {
+    type Target = StickSystem;
+
+    fn deref(&self) -> &StickSystem {
+        &self.system
+    }
 }
 
 /// Node pairs joined by the contact pairs `which` (for connectivity checks), with the period
@@ -203,196 +107,19 @@ impl PeriodicSystem {
     fn build(model: &Model, anchored: bool) -> Result<Self, Error> {
         let clock = std::time::Instant::now();
         let (periodicity, set, anchor) = prepare_cell(model, true)?;
-        let mut timings = SetupTimings {
-            contacts: clock.elapsed().as_secs_f64(),
-            ..SetupTimings::default()
-        };
-        let clock = std::time::Instant::now();
-        let closed: Vec<usize> = (0..set.pairs.len())
-            .filter(|&i| set.pairs[i].gap <= 0.0)
-            .collect();
+        let contacts = clock.elapsed().as_secs_f64();
         let discretization =
             Discretization::periodic(model, &periodicity, &[0.0; 6], anchored.then_some(anchor));
-        let elements = ElementBlocks::new(model, &discretization);
-        let contacts: Vec<ContactPair> = closed
-            .iter()
-            .map(|&i| discretization.contact_pair(&set.pairs[i]))
-            .collect();
-        let n_elements = model.elements().len();
-        let blocks: Vec<&[usize]> = (0..n_elements)
-            .map(|e| elements.gnodes_of(model, e))
-            .chain(contacts.iter().map(|c| &c.jump.nodes[..]))
-            .collect();
-        let (driver, n_gnodes) = (discretization.driver(), discretization.n_gnodes());
-        let element_colors = color_blocks(n_gnodes, blocks[..n_elements].iter().copied(), driver);
-        timings.blocks = clock.elapsed().as_secs_f64();
-        let clock = std::time::Instant::now();
-        let pattern = Pattern::from_blocks(
-            discretization.reduced_indices(),
-            discretization.n_free(),
-            &blocks,
-            n_elements,
-        )?;
-        let contact_columns = ContactColumns::new(n_gnodes, driver, &contacts, &pattern);
-        timings.pattern = clock.elapsed().as_secs_f64();
+        let (system, built) = StickSystem::build(model, discretization, &set)?;
         Ok(PeriodicSystem {
             periodicity,
-            discretization,
-            pattern,
-            elements,
-            contacts,
-            element_colors,
-            contact_columns,
+            system,
             anchor,
-            timings,
-        })
-    }
-
-    /// Number of unknowns.
-    pub fn n_free(&self) -> usize {
-        self.discretization.n_free()
-    }
-
-    /// (node, DOF) of a free unknown.
-    pub fn node_dof(&self, k: usize) -> (usize, Dof) {
-        self.discretization.node_dof(k)
-    }
-
-    /// A solver error with its column mapped to node, DOF and fibers of `model` where it
-    /// names one.
-    pub(crate) fn locate(&self, model: &Model, e: SolverError) -> Error {
-        self.discretization.locate(model, e)
-    }
-
-    /// Number of closed contacts included as stick springs.
-    pub fn n_contacts(&self) -> usize {
-        self.contacts.len()
-    }
-
-    /// The columns w₁, w₂ with K_T^st = p_T Bᵀ(t₁t₁ᵀ + t₂t₂ᵀ)B = w₁w₁ᵀ + w₂w₂ᵀ (4.58) of
-    /// closed contact `i` on the free DOFs, as (row of K_ff, value) sorted by row: switching
-    /// the contact from stick to sliding is the rank-2 downdate K_ff − w₁w₁ᵀ − w₂w₂ᵀ.
-    pub fn stick_spring_columns(&self, i: usize) -> [Vec<(usize, f64)>; 2] {
-        let pair = &self.contacts[i];
-        let root = pair.penalty_tangent.sqrt();
-        pair.tangents.map(|t| {
-            let mut column: Vec<(usize, f64)> = (0..pair.size())
-                .filter_map(|r| {
-                    let g = 6 * pair.jump.nodes[r / 6] + r % 6;
-                    let row = self.discretization.reduced(g)?;
-                    Some((row, root * pair.jump.b.column(r).dot(&t)))
-                })
-                .collect();
-            column.sort_unstable_by_key(|e| e.0);
-            column.dedup_by(|next, kept| {
-                let same = next.0 == kept.0;
-                if same {
-                    kept.1 += next.1;
-                }
-                same
-            });
-            column
-        })
-    }
-
-    /// The n × 2k matrix W of the stick springs of the closed contacts `switched` (columns 2j,
-    /// 2j + 1 from [`PeriodicSystem::stick_spring_columns`] of the j-th): K_ff with them stuck
-    /// minus K_ff with them sliding is W Wᵀ, the argument of a factor downdate
-    /// (`LinearSolver::update_factor`).
-    pub fn stick_spring_matrix(&self, switched: &[usize]) -> Result<CscMatrix, Error> {
-        let mut triplets = Vec::new();
-        for (k, &i) in switched.iter().enumerate() {
-            for (j, column) in self.stick_spring_columns(i).into_iter().enumerate() {
-                triplets.extend(column.into_iter().map(|(r, v)| (r, 2 * k + j, v)));
-            }
-        }
-        Ok(CscMatrix::from_triplets(
-            self.n_free(),
-            2 * switched.len(),
-            &triplets,
-        )?)
-    }
-
-    /// Assembles K_ff, K_fE and K_EE (elements and closed contacts in stick).
-    pub fn assemble(&self, model: &Model) -> PeriodicValues {
-        let mut out = self.zero_values();
-        self.add_elements(model, &mut out);
-        self.add_contacts(&mut out, |_| ContactStiffness::Stick);
-        out
-    }
-
-    /// All values zero.
-    pub fn zero_values(&self) -> PeriodicValues {
-        PeriodicValues {
-            values: vec![0.0; self.pattern.nnz()],
-            couplings: DriverCouplings {
-                coupling: vec![[0.0; 6]; self.discretization.n_free()],
-                k_ee: SMatrix::zeros(),
+            timings: SetupTimings {
+                contacts,
+                blocks: built.blocks,
+                pattern: built.pattern,
             },
-        }
-    }
-
-    /// Adds Tᵀ K T of every element: the colors one after another, the elements of a color in
-    /// parallel, each writing its own entries (the sums do not depend on the number of threads).
-    pub fn add_elements(&self, model: &Model, out: &mut PeriodicValues) {
-        self.add_colored(out, &self.element_colors, |e, sink| {
-            let slots = self.pattern.element_slots(e);
-            self.elements
-                .with_block(model, e, |gnodes, k| sink.add(gnodes, k, slots))
-        });
-    }
-
-    /// Adds the closed contacts, contact i with the stiffness `which(i)`: node by node in
-    /// parallel, each node's task filling its own columns (see `ContactColumns`), so the sums do
-    /// not depend on the number of threads.
-    pub fn add_contacts(
-        &self,
-        out: &mut PeriodicValues,
-        which: impl Fn(usize) -> ContactStiffness + Sync,
-    ) {
-        out.couplings.k_ee += self.contact_columns.add(
-            &self.contacts,
-            &self.pattern,
-            &self.discretization,
-            &mut out.values,
-            Some(&mut out.couplings.coupling),
-            |i| self.contacts[i].closed_block(which(i) == ContactStiffness::Stick),
-        );
-    }
-
-    /// Runs `block(i, sink)` for the blocks of each color in parallel, colors in order; the
-    /// driver–driver parts they return are summed in block order.
-    fn add_colored(
-        &self,
-        out: &mut PeriodicValues,
-        colors: &[Vec<usize>],
-        block: impl Fn(usize, &Sink<'_>) -> Option<Matrix6> + Sync,
-    ) {
-        let sink = Sink {
-            disc: &self.discretization,
-            driver: self.discretization.driver().unwrap_or(usize::MAX),
-            values: SharedMut::new(&mut out.values),
-            coupling: SharedMut::new(&mut out.couplings.coupling),
-        };
-        for color in colors {
-            let driver_blocks: Vec<Option<Matrix6>> = color
-                .par_iter()
-                .with_min_len(32)
-                .map(|&i| block(i, &sink))
-                .collect();
-            for m in driver_blocks.into_iter().flatten() {
-                out.couplings.k_ee += m;
-            }
-        }
-    }
-
-    /// Nodal displacements and rotations of every node for the unknowns `x` and the drivers `e`.
-    pub fn expand(&self, x: &[f64], e: &MacroStrain) -> Vec<[f64; 6]> {
-        let disc = &self.discretization;
-        let mut q = disc.generalized(x, 0.0);
-        if let Some(d) = disc.driver() {
-            q[6 * d..6 * d + 6].copy_from_slice(e);
-        }
-        disc.physical(&q)
+        })
     }
 }
