@@ -144,24 +144,31 @@ fn rotation_penalty_of_elements(
     }
 }
 
-/// The jump of the two touching surface points x_I + r_I n and x_II − r_II n instead of the
-/// centerline points: [u]_s = [u] + θ_I × r_I n + θ_II × r_II n = B q − [n]× (r_I R_I + r_II R_II) q.
-/// A rigid rotation ω moves the centerline points (2r apart along n) relative to each other by
-/// ω × (r_I + r_II) n, tangentially: with the centerline jump of thesis Lemma 4.26 a sticking
-/// contact resists rigid rotations, which makes the cell problems depend on where the cell
-/// lies (the macro curvature fields rotate every point differently). The surface jump moves
-/// rigidly; its normal component, and so K_N, is unchanged (nᵀ [n]× = 0).
+/// The jump of the contact point seen from either fiber, x_I + s r_I n and x_II − s r_II n with
+/// s = d / (r_I + r_II) for centerlines d = r_I + r_II + g apart (the touching surface points
+/// when g = 0; with an overlap or a gap, the one point that divides it in proportion to the
+/// radii), instead of the centerline points: [u]_s = [u] + θ_I × s r_I n + θ_II × s r_II n
+/// = B q − [n]× s (r_I R_I + r_II R_II) q. A rigid rotation ω moves the centerline points (d
+/// apart along n) relative to each other by ω × d n, tangentially: with the centerline jump of
+/// thesis Lemma 4.26 a sticking contact resists rigid rotations, which makes the cell problems
+/// depend on where the cell lies (the macro curvature fields rotate every point differently).
+/// The two points of the surface jump are one point of space, so a rigid motion moves them
+/// together (with levers r_I and r_II alone, an overlap g of the generated non-wovens left
+/// ω × g n: rotations of a free model 4·10⁻⁹ off its null space); its normal component, and so
+/// K_N, is unchanged (nᵀ [n]× = 0).
 fn surface_jump(
     model: &Model,
     mut jump: Jump,
     sides: [ContactSide; 2],
     elements: &[Vec<usize>; 2],
-    n: &Vector3<f64>,
+    (n, gap): (&Vector3<f64>, f64),
 ) -> Jump {
     let radii = [
         side_radius(model, &elements[0]),
         side_radius(model, &elements[1]),
     ];
+    let sum = radii[0] + radii[1];
+    let s = if sum > 0.0 { 1.0 + gap / sum } else { 1.0 };
     let first_side_blocks = match sides[0] {
         ContactSide::Node(_) => 1,
         ContactSide::Point { .. } => 2,
@@ -170,9 +177,9 @@ fn surface_jump(
     // jump.r holds +R_I for side I's nodes and −R_II for side II's.
     for k in 0..jump.nodes.len() {
         let lever = if k < first_side_blocks {
-            -radii[0]
+            -s * radii[0]
         } else {
-            radii[1]
+            s * radii[1]
         };
         let r_block = jump.r.fixed_view::<3, 6>(0, 6 * k).into_owned();
         let add = cross * r_block * lever;
@@ -412,7 +419,7 @@ impl ContactSet {
             })?;
             // Found by the search: the jump of the touching surface points (objective).
             let jump = if kind == "search" {
-                surface_jump(model, centerline, sides, &elements, &normal)
+                surface_jump(model, centerline, sides, &elements, (&normal, gap))
             } else {
                 centerline
             };
