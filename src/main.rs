@@ -247,9 +247,11 @@ enum Command {
         output: PathBuf,
     },
     /// Property checks of a model: symmetry, definiteness and conditioning of the system its
-    /// job solves, a cell's null space before its anchor (the three translations) and, for a
-    /// cell with contacts, the penalty study of its moduli (ABD at p, 10p, 100p, the limit
-    /// p → ∞ and the penalty an accuracy needs). Exit code 1 when a check fails.
+    /// job solves (closed contacts in stick), a cell's null space before its anchor (the three
+    /// translations) or a free model's (six rigid modes per piece), the contacts' penetration
+    /// at the solution relative to the radii and, for a cell with contacts, the penalty study
+    /// of its moduli (ABD at p, 10p, 100p, the limit p → ∞ and the penalty an accuracy
+    /// needs). Exit code 1 when a check fails.
     Check {
         /// Model file.
         model: PathBuf,
@@ -265,6 +267,14 @@ enum Command {
         /// Skip the penalty study (three more homogenizations).
         #[arg(long)]
         no_penalty_study: bool,
+        /// Cells: the macroscopic strain the contact penetration is measured at (each of
+        /// ε11, ε22, γ12 alone; curvatures 2ε/h).
+        #[arg(long, default_value_t = 1e-2)]
+        penetration_strain: f64,
+        /// Largest accepted contact penetration, relative to the smaller radius of the two
+        /// fibers.
+        #[arg(long, default_value_t = fibercell::check::DEFAULT_MAX_PENETRATION)]
+        max_penetration: f64,
     },
 }
 
@@ -1221,12 +1231,6 @@ fn check(
     options: &fibercell::check::CheckOptions,
     json: bool,
 ) -> Result<(), Error> {
-    if !(options.accuracy > 0.0 && options.accuracy < 1.0) {
-        return Err(Error::InvalidOption(format!(
-            "--accuracy {} must lie in (0, 1): it is a relative error",
-            options.accuracy
-        )));
-    }
     let model = io::load_model(model_path)?;
     let report = fibercell::check::check_model(&model, options)?;
     if json {
@@ -1390,6 +1394,8 @@ fn main() -> ExitCode {
             json,
             accuracy,
             no_penalty_study,
+            penetration_strain,
+            max_penetration,
         } => check(
             &model,
             &fibercell::check::CheckOptions {
@@ -1397,6 +1403,8 @@ fn main() -> ExitCode {
                 penalty_study: !no_penalty_study,
                 accuracy: accuracy.unwrap_or(1e-2),
                 require_accuracy: accuracy.is_some(),
+                penetration_strain,
+                max_penetration,
             },
             json,
         ),

@@ -6,7 +6,7 @@
 //! has the nonsymmetric part of its closed form. The inputs shrink towards the smallest cell
 //! (fewest fibers, loops or elements, seed 0) when a property fails.
 
-use fibercell::check::{check_model, CheckOptions};
+use fibercell::check::{check_model, rigid_mode_residuals, CheckOptions};
 use fibercell::contact::{BlockState, ContactSet, ContactState, Friction};
 use fibercell::generate::{
     geotextile, knitted, nonwoven, weave, FiberAmount, Geotextile, Knit, LengthDistribution,
@@ -141,6 +141,29 @@ proptest! {
         prop_assert!(m.positive_definite, "{cell:?}: {:?}", m.definiteness_error);
         let t = report.translations.expect("a cell");
         prop_assert!(t.relative.iter().all(|&r| r <= 1e-12), "{cell:?}: {:?}", t.relative);
+    }
+
+    /// The same cell without its `[cell]` and with no supports is a free model: its matrix
+    /// (elements and the closed contacts found without periodic images, in stick) has the six
+    /// rigid modes of each connected piece in its null space to 1e-12 relative (translations,
+    /// and rotations about each piece's centroid, which strain no element and move no contact
+    /// jump), and it is positive definite once one node of every piece is held — so the null
+    /// space is exactly those 6 × pieces modes. `check` fails such a model on definiteness
+    /// and reports the modes.
+    #[test]
+    fn a_free_model_has_the_six_rigid_modes_of_each_piece_as_null_space(cell in cells()) {
+        let mut model = model_or_reject(&cell)?;
+        model.cell = None;
+        let modes = rigid_mode_residuals(&model, &SolveOptions::default()).expect("modes");
+        prop_assert!(modes.pieces >= 1);
+        prop_assert!(
+            modes.relative.iter().all(|&r| r <= 1e-12),
+            "{cell:?}: {} pieces, {:?}", modes.pieces, modes.relative
+        );
+        prop_assert!(modes.held_positive_definite, "{cell:?}: {} pieces", modes.pieces);
+        let report = check_model(&model, &CheckOptions::default()).expect("checks run");
+        prop_assert!(!report.matrix.positive_definite && !report.passed());
+        prop_assert_eq!(report.rigid_modes.map(|m| m.pieces), Some(modes.pieces));
     }
 
     /// Assembly on one thread and on every thread gives the same matrix and driver couplings

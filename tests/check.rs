@@ -200,3 +200,75 @@ fn cli_check_json_and_options() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("--accuracy"));
 }
+
+/// Penetration at a supported model's solution, against the closed form of the thesis's two
+/// bars (§5.2.2; `fixtures/ok_contact_bars1.toml`): bar, contact spring p and bar in series
+/// under ū, so N = k ū / (2 + k/p) and the overlap N/p = 10/3 mm for k = p = 1000 N/m, ū =
+/// 1 cm — a third of the 1 cm radius: the check fails at the default 0.1 and passes at 0.5.
+#[test]
+fn penetration_at_the_solution_is_the_closed_form() {
+    let model = load_model(Path::new("fixtures/ok_contact_bars1.toml")).unwrap();
+    let (k, p, u, r) = (1000.0, 1000.0, 0.01, 0.01);
+    let want = k * u / (2.0 + k / p) / p;
+    let report = check_model(&model, &CheckOptions::default()).unwrap();
+    let pen = report.penetration.as_ref().expect("contacts");
+    let worst = pen.worst().expect("a case");
+    assert!((worst.penetration - want).abs() <= 1e-9 * want, "{worst:?}");
+    assert!((worst.ratio - want / r).abs() <= 1e-9, "{worst:?}");
+    assert_eq!((worst.contact, worst.fibers), (0, [1, 2]));
+    assert!(!report.passed());
+    let line = report
+        .checks
+        .iter()
+        .find(|c| c.name == "contact penetration");
+    assert!(!line.expect("a penetration line").passed);
+    let lenient = CheckOptions {
+        max_penetration: 0.5,
+        ..CheckOptions::default()
+    };
+    assert!(check_model(&model, &lenient).unwrap().passed());
+    let bad = CheckOptions {
+        max_penetration: f64::NAN,
+        ..CheckOptions::default()
+    };
+    let e = check_model(&model, &bad).unwrap_err().to_string();
+    assert!(e.contains("--max-penetration"), "{e}");
+}
+
+/// A cell's penetration under the macroscopic strains: linear in the strain (the generated
+/// overlaps are adjusted to ḡ = 0 by default, so nothing is added at rest), and the
+/// penalty's: a contact's overlap is N/p_N with N tending to its rigid-contact value, so ten
+/// times the penalty gives about a tenth of the worst (between 0.09 and 0.11: N grows by the
+/// penalty error of the moduli, 5–6 % here, and the worst contact may change; measured
+/// 0.0975–0.1048).
+#[test]
+fn a_cells_penetration_is_linear_in_strain_and_falls_like_the_penalty() {
+    let model = small_nonwoven();
+    let at = |model: &Model, strain: f64| {
+        let options = CheckOptions {
+            penalty_study: false,
+            penetration_strain: strain,
+            ..CheckOptions::default()
+        };
+        check_model(model, &options)
+            .unwrap()
+            .penetration
+            .expect("a cell with contacts")
+    };
+    let one = at(&model, 1e-2);
+    let two = at(&model, 2e-2);
+    assert_eq!(one.cases.len(), 6);
+    for (a, b) in one.cases.iter().zip(&two.cases) {
+        assert_eq!(a.contact, b.contact, "{a:?} {b:?}");
+        assert!((b.penetration - 2.0 * a.penetration).abs() <= 1e-9 * b.penetration);
+    }
+    let stiff = at(&with_penalty_scale(&model, 10.0), 1e-2);
+    for (a, b) in one.cases.iter().zip(&stiff.cases) {
+        let ratio = b.penetration / a.penetration;
+        println!(
+            "{}: {:.3e} → {:.3e} ({ratio:.4})",
+            a.load, a.penetration, b.penetration
+        );
+        assert!((0.09..=0.11).contains(&ratio), "{}: ratio {ratio}", a.load);
+    }
+}

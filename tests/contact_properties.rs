@@ -386,10 +386,9 @@ fn a_finely_meshed_fiber_does_not_touch_itself_but_a_folded_one_does() {
 #[test]
 fn a_rigid_rotation_gives_no_contact_jump() {
     let omega = nalgebra::Vector3::new(0.3, -0.2, 0.5);
-    let nonwoven = fibercell::io::read_description(std::path::Path::new(
-        "fixtures/cells/nonwoven_small.toml",
-    ))
-    .unwrap();
+    let nonwoven =
+        fibercell::io::read_description(std::path::Path::new("fixtures/cells/nonwoven_small.toml"))
+            .unwrap();
     for mut d in [
         fibercell::generate::crossing_grid(3, 2, 1e-2, 1e-3),
         fibercell::generate::knitted(&fibercell::generate::Knit::default()).unwrap(),
@@ -415,7 +414,11 @@ fn a_rigid_rotation_gives_no_contact_jump() {
                 .iter()
                 .map(|f| f.section.radius)
                 .fold(f64::MAX, f64::min);
-            assert!(jump.norm() <= 1e-12 * omega.norm() * r, "{jump:?}, gap {}", pair.gap);
+            assert!(
+                jump.norm() <= 1e-12 * omega.norm() * r,
+                "{jump:?}, gap {}",
+                pair.gap
+            );
         }
     }
 }

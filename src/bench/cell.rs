@@ -106,9 +106,9 @@ pub struct ReuseBench {
     #[serde(default)]
     pub cholmod_refactorization_seconds: Option<f64>,
     /// CHOLMOD's downdate of its factor by the switched contacts' stick springs (rank 2k,
-    /// [`PeriodicSystem::stick_spring_columns`]) plus one solve (s), the first after a
-    /// factorization: it includes copying the supernodal factor into a simplicial LDLᵀ. Absent
-    /// without the cholmod feature.
+    /// [`crate::homogenize::StickSystem::stick_spring_columns`]) plus one solve (s), the
+    /// first after a factorization: it includes copying the supernodal factor into a
+    /// simplicial LDLᵀ. Absent without the cholmod feature.
     #[serde(default)]
     pub updown_seconds: Option<f64>,
     /// That relative to CHOLMOD's refactorization plus solve.

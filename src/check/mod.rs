@@ -1,21 +1,28 @@
 //! Property checks a user runs on their own model (`fibercell check MODEL`): the symmetry,
-//! definiteness and conditioning of the system its job solves, the null space of a cell's
-//! system before its anchor, and for a cell with contacts the penalty study of its moduli
-//! (ABD at p, 10p, 100p, the Richardson limit p → ∞ and the penalty an accuracy needs).
+//! definiteness and conditioning of the system its job solves (closed contacts in stick), the
+//! null space of a cell's system before its anchor (or of a free model's), the contacts'
+//! penetration at the solution relative to the radii, and for a cell with contacts the penalty
+//! study of its moduli (ABD at p, 10p, 100p, the Richardson limit p → ∞ and the penalty an
+//! accuracy needs).
 //!
-//! The flow: set up the job's system → assemble → factorize and measure → (cells) the
-//! unanchored system and the penalty study → verdict.
+//! The flow: set up the job's system → assemble → factorize and measure → the solution's
+//! penetration → (cells) the unanchored system and the penalty study, (free models) the rigid
+//! modes → verdict.
 
 mod matrix_checks;
 mod null_space;
 mod penalty_study;
+mod penetration;
+mod rigid_modes;
 
 pub use matrix_checks::{asymmetry, matrix_checks, MatrixChecks};
 pub use null_space::{translation_residuals, TranslationResiduals};
 pub use penalty_study::{penalty_study, PenaltyEntry, PenaltyStudy, STUDY_SCALES};
+pub use penetration::{cell_penetration, solution_penetration, PenetrationCase, PenetrationCheck};
+pub use rigid_modes::{rigid_mode_residuals, RigidModes};
 
-use crate::homogenize::PeriodicSystem;
-use crate::solve::{ReducedSystem, SolveOptions, SolverKind};
+use crate::homogenize::{cell_rhs, PeriodicSystem, StickSystem};
+use crate::solve::{SolveOptions, SolverKind};
 use crate::{Error, Model};
 use serde::Serialize;
 
@@ -25,6 +32,11 @@ pub const SYMMETRY_TOLERANCE: f64 = 1e-14;
 pub const TRANSLATION_TOLERANCE: f64 = 1e-12;
 /// Largest accepted backward error of the check solve.
 pub const BACKWARD_ERROR_TOLERANCE: f64 = 1e-10;
+/// Default largest penetration of a closed contact relative to the smaller radius of its
+/// fibers ([`CheckOptions::max_penetration`]).
+pub const DEFAULT_MAX_PENETRATION: f64 = 0.1;
+/// Largest accepted ‖K r‖∞ / (‖K‖∞ ‖r‖∞) of a rigid mode r of a free model.
+pub const RIGID_MODE_TOLERANCE: f64 = 1e-12;
 
 /// What [`check_model`] does.
 #[derive(Clone, Debug)]
@@ -39,6 +51,38 @@ pub struct CheckOptions {
     pub accuracy: f64,
     /// Fail when the model's penalty error exceeds `accuracy`.
     pub require_accuracy: bool,
+    /// Cells: the size of the macroscopic strains the penetration is measured at (each of
+    /// ε11, ε22, γ12 alone; curvatures 2ε/h).
+    pub penetration_strain: f64,
+    /// Largest accepted penetration of a closed contact relative to the smaller radius of its
+    /// fibers.
+    pub max_penetration: f64,
+}
+
+impl CheckOptions {
+    /// An error naming the first option out of its range.
+    pub fn validate(&self) -> Result<(), Error> {
+        if !(self.accuracy > 0.0 && self.accuracy < 1.0) {
+            return Err(Error::InvalidOption(format!(
+                "accuracy (--accuracy) {} must lie in (0, 1): it is a relative error",
+                self.accuracy
+            )));
+        }
+        for (name, v) in [
+            (
+                "penetration_strain (--penetration-strain)",
+                self.penetration_strain,
+            ),
+            ("max_penetration (--max-penetration)", self.max_penetration),
+        ] {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(Error::InvalidOption(format!(
+                    "{name} {v} must be a positive number"
+                )));
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Default for CheckOptions {
@@ -48,6 +92,8 @@ impl Default for CheckOptions {
             penalty_study: true,
             accuracy: 1e-2,
             require_accuracy: false,
+            penetration_strain: 1e-2,
+            max_penetration: DEFAULT_MAX_PENETRATION,
         }
     }
 }
@@ -74,6 +120,10 @@ pub struct CheckReport {
     pub matrix: MatrixChecks,
     /// Cells: the unanchored system on the rigid translations.
     pub translations: Option<TranslationResiduals>,
+    /// Free models (no supports, no cell): the system on the rigid modes of its pieces.
+    pub rigid_modes: Option<RigidModes>,
+    /// Models with contacts: the closed contacts' penetration at the solution.
+    pub penetration: Option<PenetrationCheck>,
     /// Cells with contacts: the penalty study.
     pub penalty: Option<PenaltyStudy>,
     /// The verdict, line by line.
@@ -87,44 +137,78 @@ impl CheckReport {
     }
 }
 
-/// Runs the checks on `model`: a cell (with `[cell]`) or a supported model.
+/// Runs the checks on `model`: a cell (with `[cell]`), a supported model or a free one.
 pub fn check_model(model: &Model, options: &CheckOptions) -> Result<CheckReport, Error> {
+    options.validate()?;
     let mut solve = options.solve.clone();
     if solve.solver != SolverKind::Cholmod {
         solve.solver = SolverKind::FaerCholesky;
     }
     let cell = model.cell.is_some();
-    let (matrix, contacts) = if cell {
-        let sys = PeriodicSystem::new(model)?;
+    let free = !cell && model.supports.is_empty();
+    let (matrix, contacts, penetration) = if cell {
+        cell_checks(model, &solve, options.penetration_strain)?
+    } else {
+        let sys = StickSystem::supported(model)?;
         let values = sys.assemble(model);
-        let a = sys.pattern.matrix(&values.values)?;
         let mut solver = solve
             .solver_config(sys.discretization.node_block_starts())
             .build()?;
-        let checks = matrix_checks(a, solver.as_mut(), &|e| sys.locate(model, e))?;
-        (checks, sys.n_contacts())
-    } else {
-        let sys = ReducedSystem::assemble(model, solve.fill)?;
-        let mut solver = solve.solver_config(sys.dofs.node_block_starts()).build()?;
-        let locate = |e| sys.dofs.locate(model, e);
-        (matrix_checks(sys.matrix()?, solver.as_mut(), &locate)?, 0)
+        let a = sys.pattern.matrix(&values.values)?;
+        let matrix = matrix_checks(a, solver.as_mut(), &|e| sys.locate(model, e))?;
+        let penetration = (!free && sys.n_contacts() > 0 && matrix.positive_definite)
+            .then(|| solution_penetration(model, &options.solve))
+            .transpose()?;
+        (matrix, sys.n_contacts(), penetration)
     };
     let translations = cell.then(|| translation_residuals(model)).transpose()?;
+    let rigid_modes = free
+        .then(|| rigid_mode_residuals(model, &solve))
+        .transpose()?;
     let penalty = (cell && contacts > 0 && options.penalty_study && matrix.positive_definite)
         .then(|| penalty_study(model, &solve, options.accuracy))
         .transpose()?;
-    let checks = verdict(&matrix, translations.as_ref(), penalty.as_ref(), options);
-    Ok(CheckReport {
-        system: if cell {
-            "the six elastic cell problems (closed contacts in stick)"
-        } else {
-            "the reduced static problem K u = F"
+    let mut report = CheckReport {
+        system: match (cell, free, contacts > 0) {
+            (true, _, _) => "the six elastic cell problems (closed contacts in stick)",
+            (false, true, _) => "the free model's K (no supports: singular by its rigid modes)",
+            (false, false, true) => "the static problem with the closed contacts in stick",
+            (false, false, false) => "the reduced static problem K u = F",
         },
         matrix,
         translations,
+        rigid_modes,
+        penetration,
         penalty,
-        checks,
-    })
+        checks: Vec::new(),
+    };
+    report.checks = verdict(&report, options);
+    Ok(report)
+}
+
+/// A cell's matrix checks, its number of closed contacts and their penetration under the
+/// six macroscopic strains of size `strain`, all on one factorization.
+fn cell_checks(
+    model: &Model,
+    solve: &SolveOptions,
+    strain: f64,
+) -> Result<(MatrixChecks, usize, Option<PenetrationCheck>), Error> {
+    let sys = PeriodicSystem::new(model)?;
+    let values = sys.assemble(model);
+    let a = sys.pattern.matrix(&values.values)?;
+    let mut solver = solve
+        .solver_config(sys.discretization.node_block_starts())
+        .build()?;
+    let locate = |e| sys.locate(model, e);
+    let checks = matrix_checks(a, solver.as_mut(), &locate)?;
+    if !checks.positive_definite || sys.n_contacts() == 0 {
+        return Ok((checks, sys.n_contacts(), None));
+    }
+    let n = sys.n_free();
+    let rhs = cell_rhs(&values.couplings, n, 0);
+    let (x, _) = crate::solver::solve_checked(solver.as_mut(), a, &rhs, 6).map_err(locate)?;
+    let penetration = cell_penetration(model, &sys, &x, strain);
+    Ok((checks, sys.n_contacts(), Some(penetration)))
 }
 
 fn line(name: &str, value: String, limit: &str, passed: bool) -> CheckLine {
@@ -137,12 +221,8 @@ fn line(name: &str, value: String, limit: &str, passed: bool) -> CheckLine {
 }
 
 /// The pass/fail lines of the measurements.
-fn verdict(
-    matrix: &MatrixChecks,
-    translations: Option<&TranslationResiduals>,
-    penalty: Option<&PenaltyStudy>,
-    options: &CheckOptions,
-) -> Vec<CheckLine> {
+fn verdict(report: &CheckReport, options: &CheckOptions) -> Vec<CheckLine> {
+    let matrix = &report.matrix;
     let mut out = vec![
         line(
             "symmetric",
@@ -171,7 +251,7 @@ fn verdict(
             b <= BACKWARD_ERROR_TOLERANCE,
         ));
     }
-    if let Some(t) = translations {
+    if let Some(t) = &report.translations {
         let worst = t.relative.iter().fold(0.0f64, |m, &v| m.max(v));
         out.push(line(
             "null space = 3 translations",
@@ -180,7 +260,35 @@ fn verdict(
             worst <= TRANSLATION_TOLERANCE && matrix.positive_definite,
         ));
     }
-    if let Some(p) = penalty {
+    if let Some(m) = &report.rigid_modes {
+        let worst = m.relative.iter().fold(0.0f64, |w, &v| w.max(v));
+        out.push(line(
+            "null space = 6 rigid modes per piece",
+            format!(
+                "{} piece(s), ‖K r‖∞/(‖K‖∞‖r‖∞) ≤ {worst:.2e}, {}",
+                m.pieces,
+                if m.held_positive_definite {
+                    "definite with one node per piece held"
+                } else {
+                    "singular with one node per piece held"
+                }
+            ),
+            "≤ 1e-12, and definite with one node per piece held",
+            worst <= RIGID_MODE_TOLERANCE && m.held_positive_definite,
+        ));
+    }
+    if let Some(c) = report.penetration.as_ref().and_then(|p| p.worst()) {
+        out.push(line(
+            "contact penetration",
+            format!(
+                "{:.2e} of the smaller radius ({:.2e} m at {}, contact {}, fibers {}–{})",
+                c.ratio, c.penetration, c.load, c.contact, c.fibers[0], c.fibers[1]
+            ),
+            &format!("≤ {} of the smaller radius", options.max_penetration),
+            c.ratio <= options.max_penetration,
+        ));
+    }
+    if let Some(p) = &report.penalty {
         let worst = p
             .entries
             .iter()

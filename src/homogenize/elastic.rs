@@ -163,7 +163,7 @@ fn abd_of(couplings: &DriverCouplings, x: &[f64], n: usize, area: f64) -> [[f64;
 
 /// The right-hand sides −K_fE e_k of the six cell problems, stacked, with room for `extra`
 /// more columns (zero).
-fn cell_rhs(couplings: &DriverCouplings, n: usize, extra: usize) -> Vec<f64> {
+pub(crate) fn cell_rhs(couplings: &DriverCouplings, n: usize, extra: usize) -> Vec<f64> {
     let mut rhs = vec![0.0; (6 + extra) * n];
     for (i, c) in couplings.coupling.iter().enumerate() {
         for k in 0..6 {

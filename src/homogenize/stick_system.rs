@@ -197,7 +197,7 @@ impl StickSystem {
         Ok((system, timings))
     }
 
-/// Number of unknowns.
+    /// Number of unknowns.
     pub fn n_free(&self) -> usize {
         self.discretization.n_free()
     }
@@ -245,7 +245,7 @@ impl StickSystem {
     }
 
     /// The n × 2k matrix W of the stick springs of the closed contacts `switched` (columns 2j,
-    /// 2j + 1 from [`PeriodicSystem::stick_spring_columns`] of the j-th): K_ff with them stuck
+    /// 2j + 1 from [`StickSystem::stick_spring_columns`] of the j-th): K_ff with them stuck
     /// minus K_ff with them sliding is W Wᵀ, the argument of a factor downdate
     /// (`LinearSolver::update_factor`).
     pub fn stick_spring_matrix(&self, switched: &[usize]) -> Result<CscMatrix, Error> {

@@ -202,6 +202,36 @@ fn curve_json(
     to_json(&c)
 }
 
+/// `check`: the property checks of a model, as the JSON `fibercell check --json` prints.
+#[pyfunction]
+#[pyo3(signature = (model, accuracy = None, penalty_study = true, max_penetration = 0.1,
+                    penetration_strain = 0.01, solver = "faer-cholesky", ordering = "auto"))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments
+fn check_json(
+    py: Python<'_>,
+    model: &Model,
+    accuracy: Option<f64>,
+    penalty_study: bool,
+    max_penetration: f64,
+    penetration_strain: f64,
+    solver: &str,
+    ordering: &str,
+) -> PyResult<String> {
+    let options = fibercell::check::CheckOptions {
+        solve: solve_options(solver, ordering)?,
+        penalty_study,
+        accuracy: accuracy.unwrap_or(1e-2),
+        require_accuracy: accuracy.is_some(),
+        penetration_strain,
+        max_penetration,
+    };
+    let m = &model.model;
+    let report = py
+        .detach(|| fibercell::check::check_model(m, &options))
+        .map_err(error)?;
+    to_json(&report)
+}
+
 /// A square CSC matrix from NumPy arrays (both triangles of a symmetric matrix).
 fn csc(
     n: usize,
@@ -296,5 +326,6 @@ fn _fibercell(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(generate_json, m)?)?;
     m.add_function(wrap_pyfunction!(homogenize_json, m)?)?;
     m.add_function(wrap_pyfunction!(curve_json, m)?)?;
+    m.add_function(wrap_pyfunction!(check_json, m)?)?;
     Ok(())
 }

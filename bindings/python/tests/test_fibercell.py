@@ -63,6 +63,24 @@ def test_curve_equals_the_cli_to_the_last_digit():
     assert np.all(np.diff(ours["arrays"]["dissipated"]) >= 0.0)
 
 
+def test_check_equals_the_cli_and_fails_where_it_does():
+    path = "fixtures/cells/woven_small.toml"
+    ours = fibercell.check(fibercell.Model.load(ROOT / path), penalty_study=False)
+    theirs = run_json("check", path, "--no-penalty-study")
+    assert ours.pop("passed") is True
+    assert ours == theirs
+    # The thesis's two bars (p = k = 1000 N/m, ū = 1 cm): N = k ū / (2 + k/p) = 10/3 N, a
+    # penetration N/p of 3.33 mm, a third of their 1 cm radius: above 0.1, not above 0.5.
+    bars = fibercell.Model.load(ROOT / "fixtures/ok_contact_bars1.toml")
+    doc = fibercell.check(bars)
+    assert doc["passed"] is False
+    worst = max(doc["penetration"]["cases"], key=lambda c: c["ratio"])
+    assert math.isclose(worst["penetration"], 1e-2 / 3, rel_tol=1e-9)
+    assert fibercell.check(bars, max_penetration=0.5)["passed"] is True
+    with pytest.raises(fibercell.FibercellError, match="max_penetration"):
+        fibercell.check(bars, max_penetration=-1.0)
+
+
 def test_models_from_strings_and_dicts_are_the_file_model():
     text = (ROOT / "fixtures/ok_frame3d.toml").read_text()
     from_toml = fibercell.Model.from_toml(text)

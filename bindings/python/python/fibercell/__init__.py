@@ -32,6 +32,7 @@ __all__ = [
     "Model",
     "SparseSolver",
     "__version__",
+    "check",
     "curve",
     "generate",
     "homogenize",
@@ -60,6 +61,36 @@ def homogenize(model: Model, solver: str = "faer-cholesky", ordering: str = "aut
     columns e11 e22 g12 k11 k22 k12; A in N/m, B in N, D in N·m)."""
     doc = json.loads(_fibercell.homogenize_json(model, solver=solver, ordering=ordering))
     doc["abd"] = np.array(doc["abd"], dtype=float)
+    return doc
+
+
+def check(
+    model: Model,
+    accuracy: Optional[float] = None,
+    penalty_study: bool = True,
+    max_penetration: float = 0.1,
+    penetration_strain: float = 0.01,
+    solver: str = "faer-cholesky",
+    ordering: str = "auto",
+) -> dict:
+    """The property checks of ``fibercell check --json``: symmetry, definiteness,
+    conditioning and null space of the model's system (closed contacts in stick), the
+    contacts' penetration relative to the smaller radius (at most ``max_penetration``; a
+    cell's under each macroscopic strain of size ``penetration_strain``) and a cell's penalty
+    study (with ``accuracy``, a larger penalty error fails). ``doc["passed"]`` says whether
+    every line of ``doc["checks"]`` passed; a failed check is a result, not an exception."""
+    doc = json.loads(
+        _fibercell.check_json(
+            model,
+            accuracy=accuracy,
+            penalty_study=penalty_study,
+            max_penetration=max_penetration,
+            penetration_strain=penetration_strain,
+            solver=solver,
+            ordering=ordering,
+        )
+    )
+    doc["passed"] = all(c["passed"] for c in doc["checks"])
     return doc
 
 

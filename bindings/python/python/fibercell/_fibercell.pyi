@@ -1,7 +1,7 @@
 """Type stubs of the compiled extension (see ``fibercell/__init__.py`` for the public API)."""
 
 from os import PathLike
-from typing import Any, Dict, Tuple, Union
+from typing import Any, Dict, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -78,6 +78,15 @@ class Cell:
 
 def generate_json(params: str) -> Model: ...
 def homogenize_json(model: Model, solver: str = "faer-cholesky", ordering: str = "auto") -> str: ...
+def check_json(
+    model: Model,
+    accuracy: Optional[float] = None,
+    penalty_study: bool = True,
+    max_penetration: float = 0.1,
+    penetration_strain: float = 0.01,
+    solver: str = "faer-cholesky",
+    ordering: str = "auto",
+) -> str: ...
 def curve_json(
     model: Model,
     strain: str,
