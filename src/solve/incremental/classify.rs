@@ -32,16 +32,15 @@ impl ResidualFloor {
     /// most [`STALLED_EQUILIBRIUM_TOLERANCE`] and not below half the smaller of the two
     /// iterations before (both recorded).
     fn stalled(&mut self, iteration: usize, r: f64) -> bool {
-        let before: Vec<f64> = self
-            .seen
-            .iter()
-            .filter(|(i, _)| *i + 2 >= iteration && *i < iteration)
-            .map(|(_, v)| *v)
-            .collect();
+        let at = |k: usize| {
+            self.seen
+                .iter()
+                .find(|(i, _)| *i + k == iteration)
+                .map(|&(_, v)| v)
+        };
+        let before = at(1).zip(at(2)).map(|(a, b)| a.min(b));
         self.seen.push((iteration, r));
-        let distinct = |k: usize| self.seen.iter().any(|(i, _)| *i + k == iteration);
-        let best = before.iter().copied().fold(f64::INFINITY, f64::min);
-        distinct(1) && distinct(2) && r <= STALLED_EQUILIBRIUM_TOLERANCE && r >= 0.5 * best
+        before.is_some_and(|best| r <= STALLED_EQUILIBRIUM_TOLERANCE && r >= 0.5 * best)
     }
 }
 
