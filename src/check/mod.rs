@@ -18,10 +18,11 @@ mod rigid_modes;
 pub use matrix_checks::{asymmetry, matrix_checks, MatrixChecks};
 pub use null_space::{translation_residuals, TranslationResiduals};
 pub use penalty_study::{penalty_study, PenaltyEntry, PenaltyStudy, STUDY_SCALES};
+use penalty_study::{penalty_study_from, ScaledAbd};
 pub use penetration::{cell_penetration, solution_penetration, PenetrationCase, PenetrationCheck};
 pub use rigid_modes::{rigid_mode_residuals, RigidModes};
 
-use crate::homogenize::{cell_rhs, PeriodicSystem, StickSystem};
+use crate::homogenize::{abd_asymmetry, abd_of, cell_rhs, PeriodicSystem, StickSystem};
 use crate::solve::{SolveOptions, SolverKind};
 use crate::{Error, Model};
 use serde::Serialize;
@@ -146,8 +147,14 @@ pub fn check_model(model: &Model, options: &CheckOptions) -> Result<CheckReport,
     }
     let cell = model.cell.is_some();
     let free = !cell && model.supports.is_empty();
+    let mut at_model = None;
     let (matrix, contacts, penetration) = if cell {
-        cell_checks(model, &solve, options.penetration_strain)?
+        let (checks, contacts, solved) = cell_checks(model, &solve, options.penetration_strain)?;
+        let penetration = solved.map(|(p, abd)| {
+            at_model = Some(abd);
+            p
+        });
+        (checks, contacts, penetration)
     } else {
         let sys = StickSystem::supported(model)?;
         let values = sys.assemble(model);
@@ -166,7 +173,7 @@ pub fn check_model(model: &Model, options: &CheckOptions) -> Result<CheckReport,
         .then(|| rigid_mode_residuals(model, &solve))
         .transpose()?;
     let penalty = (cell && contacts > 0 && options.penalty_study && matrix.positive_definite)
-        .then(|| penalty_study(model, &solve, options.accuracy))
+        .then(|| penalty_study_from(model, &solve, options.accuracy, at_model))
         .transpose()?;
     let mut report = CheckReport {
         system: match (cell, free, contacts > 0) {
@@ -186,13 +193,14 @@ pub fn check_model(model: &Model, options: &CheckOptions) -> Result<CheckReport,
     Ok(report)
 }
 
-/// A cell's matrix checks, its number of closed contacts and their penetration under the
-/// six macroscopic strains of size `strain`, all on one factorization.
-fn cell_checks(
-    model: &Model,
-    solve: &SolveOptions,
-    strain: f64,
-) -> Result<(MatrixChecks, usize, Option<PenetrationCheck>), Error> {
+/// What [`cell_checks`] measured: the matrix checks, the number of closed contacts and, with
+/// contacts and a definite matrix, their penetration and the model's ABD.
+type CellChecks = (MatrixChecks, usize, Option<(PenetrationCheck, ScaledAbd)>);
+
+/// A cell's matrix checks, its number of closed contacts and — with contacts and a definite
+/// matrix — their penetration under the six macroscopic strains of size `strain` and the
+/// model's ABD (the penalty study's ×1), all on one factorization.
+fn cell_checks(model: &Model, solve: &SolveOptions, strain: f64) -> Result<CellChecks, Error> {
     let sys = PeriodicSystem::new(model)?;
     let values = sys.assemble(model);
     let a = sys.pattern.matrix(&values.values)?;
@@ -206,9 +214,15 @@ fn cell_checks(
     }
     let n = sys.n_free();
     let rhs = cell_rhs(&values.couplings, n, 0);
-    let (x, _) = crate::solver::solve_checked(solver.as_mut(), a, &rhs, 6).map_err(locate)?;
+    let (x, report) = crate::solver::solve_checked(solver.as_mut(), a, &rhs, 6).map_err(locate)?;
     let penetration = cell_penetration(model, &sys, &x, strain);
-    Ok((checks, sys.n_contacts(), Some(penetration)))
+    let abd = abd_of(&values.couplings, &x, n, sys.periodicity.geometry.area());
+    let at_model = ScaledAbd {
+        abd,
+        backward_error: report.backward_error,
+        asymmetry: abd_asymmetry(&abd),
+    };
+    Ok((checks, sys.n_contacts(), Some((penetration, at_model))))
 }
 
 fn line(name: &str, value: String, limit: &str, passed: bool) -> CheckLine {

@@ -69,6 +69,14 @@ pub struct PenaltyStudy {
 
 const NAMES: [&str; 6] = ["A11", "A22", "A66", "D11", "D22", "D66"];
 
+/// ABD at one penalty scale with its backward error and round-off (ABD's asymmetry).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ScaledAbd {
+    pub abd: [[f64; 6]; 6],
+    pub backward_error: f64,
+    pub asymmetry: f64,
+}
+
 /// ABD of `model` with its penalties scaled by [`STUDY_SCALES`] and the limit per diagonal
 /// modulus, with the penalty for `accuracy` and warnings where round-off would dominate.
 pub fn penalty_study(
@@ -76,11 +84,26 @@ pub fn penalty_study(
     options: &SolveOptions,
     accuracy: f64,
 ) -> Result<PenaltyStudy, Error> {
+    penalty_study_from(model, options, accuracy, None)
+}
+
+/// [`penalty_study`] with the model's own ABD (×1) already computed, when `at_model` gives it.
+pub(crate) fn penalty_study_from(
+    model: &Model,
+    options: &SolveOptions,
+    accuracy: f64,
+    at_model: Option<ScaledAbd>,
+) -> Result<PenaltyStudy, Error> {
     let model_scale = model.contact.as_ref().map_or(1.0, |c| c.penalty_scale);
     let mut abd = [[[0.0; 6]; 6]; 3];
     let mut backward_errors = [0.0; 3];
     let mut roundoff = [0.0; 3];
     for (k, s) in STUDY_SCALES.iter().enumerate() {
+        if let (0, Some(first)) = (k, at_model) {
+            (abd[0], backward_errors[0], roundoff[0]) =
+                (first.abd, first.backward_error, first.asymmetry);
+            continue;
+        }
         let mut scaled = model.clone();
         if let Some(c) = scaled.contact.as_mut() {
             c.penalty_scale = model_scale * s;

@@ -148,7 +148,7 @@ fn factor_cell(
 
 /// ABD = (K_EE + K_Ef x) / |Y| from the driver couplings and the six cell-problem solutions
 /// x = −K_ff⁻¹ K_fE (columns of length `n`, stacked).
-fn abd_of(couplings: &DriverCouplings, x: &[f64], n: usize, area: f64) -> [[f64; 6]; 6] {
+pub(crate) fn abd_of(couplings: &DriverCouplings, x: &[f64], n: usize, area: f64) -> [[f64; 6]; 6] {
     let mut abd = [[0.0; 6]; 6];
     for (j, row) in abd.iter_mut().enumerate() {
         for (k, v) in row.iter_mut().enumerate() {
@@ -159,6 +159,16 @@ fn abd_of(couplings: &DriverCouplings, x: &[f64], n: usize, area: f64) -> [[f64;
         }
     }
     abd
+}
+
+/// max |ABD − ABDᵀ| / max |ABD|: zero in exact arithmetic, so the round-off of the moduli.
+pub(crate) fn abd_asymmetry(abd: &[[f64; 6]; 6]) -> f64 {
+    let scale = abd.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    (0..6)
+        .flat_map(|j| (0..6).map(move |k| (j, k)))
+        .map(|(j, k)| (abd[j][k] - abd[k][j]).abs())
+        .fold(0.0f64, f64::max)
+        / scale.max(f64::MIN_POSITIVE)
 }
 
 /// The right-hand sides −K_fE e_k of the six cell problems, stacked, with room for `extra`
@@ -306,12 +316,7 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
         displacements: sys.expand(theta, &[0.0; 6]),
     };
     let abd = abd_of(&vals.couplings, &x, n, area);
-    let scale = abd.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-    let asym = (0..6)
-        .flat_map(|j| (0..6).map(move |k| (j, k)))
-        .map(|(j, k)| (abd[j][k] - abd[k][j]).abs())
-        .fold(0.0f64, f64::max)
-        / scale.max(f64::MIN_POSITIVE);
+    let asym = abd_asymmetry(&abd);
     let cases = (0..6)
         .map(|k| {
             let mut e = [0.0; 6];

@@ -15,7 +15,7 @@ pub(crate) mod system;
 pub use curve::{
     elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEvent, MAX_MACRO_STRAIN,
 };
-pub(crate) use elastic::cell_rhs;
+pub(crate) use elastic::{abd_asymmetry, abd_of, cell_rhs};
 pub use elastic::{
     cell_problem, elastic_abd, homogenize_elastic, HomogenizeTimings, Homogenized, LinearSystem,
     PressureResponse,
