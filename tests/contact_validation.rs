@@ -433,3 +433,59 @@ fn progress_is_reported_after_every_increment() {
     solve_incremental(&m, &opts).unwrap();
     assert_eq!(*seen.lock().unwrap(), vec![(1, 3), (2, 3), (3, 3)]);
 }
+
+/// The penalty limit of a contact force across twelve decades: the crossing beams above with
+/// p = 10⁰ … 10¹² × the default penalty (1000 × the stiffer element's 12EI/L³). The force is
+/// the closed form N(p) = P (p/k_B)/(1 + p/k_B + p/k_A) up to round-off, which grows with p:
+/// measured |N − N(p)|/N(p) = 5·10⁻¹³ at 10⁰, 10⁻⁸ at 10⁴, 6·10⁻⁵ at 10⁸, 100 % at 10¹² (the
+/// penetration N/p is then below the displacements' round-off). The increment's reported
+/// equilibrium residual ‖R‖/‖F‖ tracks it in every decade (the elements carry the force
+/// the displacements give, the law the one the penetration gives; their difference is R at
+/// the contact): |N − N(p)| ≤ 2 ‖R‖ measured 1.3 ‖R‖, with ‖F‖ = P. So round-off is never
+/// silent — but from 10⁵ the residual exceeds 10⁻⁸ without an error or warning (an open
+/// point of issue 32). Up to 10³ the force is the closed form to 10⁻⁹; up to 10², where
+/// round-off is far below the penalty error (10⁻⁵ of it), the distance to the rigid limit
+/// P k_A/(k_A + k_B) falls like 1/p.
+#[test]
+fn the_contact_force_reaches_its_rigid_limit_across_twelve_decades() {
+    let (e, l, ra, rb, load) = (2.0e11f64, 1.0f64, 0.01f64, 0.015f64, 100.0f64);
+    let pi = std::f64::consts::PI;
+    let k = |r: f64| 192.0 * e * pi * r.powi(4) / 4.0 / l.powi(3);
+    let (ka, kb) = (k(ra), k(rb));
+    let limit = load * ka / (ka + kb);
+    let default = run(
+        &io::parse_toml(&crossing(None), "crossing.toml").unwrap(),
+        1,
+    )
+    .contacts
+    .pairs[0]
+        .penalty_normal;
+    let mut penalty_errors = Vec::new();
+    for j in 0..=12 {
+        let p = default * 10f64.powi(j);
+        let sol = run(
+            &io::parse_toml(&crossing(Some(p)), "crossing.toml").unwrap(),
+            1,
+        );
+        let n = sol.contact_results[0][0].normal_force;
+        let exact = load * (p / kb) / (1.0 + p / kb + p / ka);
+        let residual = sol.increments[0].equilibrium_residual;
+        assert!(
+            (n - exact).abs() <= 2.0 * residual * load + 1e-12 * load,
+            "10^{j}: N {n} against {exact}, residual {residual:e}"
+        );
+        if j <= 3 {
+            assert!((n - exact).abs() <= 1e-9 * exact, "10^{j}: {n} vs {exact}");
+        }
+        if j <= 2 {
+            penalty_errors.push((limit - n) * p);
+        }
+    }
+    // (limit − N) p is constant (P / (k_B S²), S = 1/k_A + 1/k_B) up to O(1/p).
+    let s = 1.0 / ka + 1.0 / kb;
+    let c = load / (kb * s * s);
+    for (j, err) in penalty_errors.iter().enumerate() {
+        let tol = 2.0 * kb / (default * 10f64.powi(j as i32)) + 1e-4;
+        assert!(((err - c) / c).abs() <= tol, "10^{j}: {err} vs {c}");
+    }
+}
