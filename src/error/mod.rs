@@ -62,6 +62,19 @@ pub enum Error {
         /// The held contacts, described.
         held: Vec<String>,
     },
+    /// The state iteration of an increment settled with no contact held, but its equilibrium
+    /// residual is above [`crate::solve::MAX_SETTLED_RESIDUAL`]: the contact forces N = p g are
+    /// round-off, the penetrations g = N/p having approached the round-off of the
+    /// displacements.
+    #[error("increment {step}: every contact settled, but the equilibrium residual ‖R‖/‖F‖ = {residual:.1e} is above {limit:.0e}: the contact forces are round-off — the penalties are so large that the penetrations N/p approach the round-off of the displacements; lower them (`penalty_scale` in [contact]; `fibercell check` names the scale an accuracy needs)")]
+    RoundOff {
+        /// Increment (1-based).
+        step: usize,
+        /// Its equilibrium residual.
+        residual: f64,
+        /// The limit it exceeds.
+        limit: f64,
+    },
     /// An option is out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),

@@ -20,7 +20,7 @@ pub use incremental::{
     solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
     IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, ProgressFn, BOUND_TOLERANCE,
     EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS,
-    MAX_LOW_RANK_COLUMNS, STALLED_EQUILIBRIUM_TOLERANCE,
+    MAX_LOW_RANK_COLUMNS, MAX_SETTLED_RESIDUAL, STALLED_EQUILIBRIUM_TOLERANCE,
 };
 pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
 pub use matrix_solve::{

@@ -50,7 +50,7 @@ pub use driver_couplings::DriverCouplings;
 pub use options::{
     IncrementalOptions, Progress, ProgressFn, BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE,
     MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
-    STALLED_EQUILIBRIUM_TOLERANCE,
+    MAX_SETTLED_RESIDUAL, STALLED_EQUILIBRIUM_TOLERANCE,
 };
 pub use records::{
     ContactRecord, EnergyBalance, IncrementRecord, IncrementalSolution, LowRankSizes,
@@ -290,11 +290,19 @@ impl<'s, 'a, 'h> StickSlip<'s, 'a, 'h> {
         Err(Error::InvalidOption("no state iteration ran".into()))
     }
 
-    /// An increment that held contacts must still be in equilibrium (see [`MAX_HELD_RESIDUAL`]).
+    /// An increment must end in equilibrium: one that held contacts to
+    /// [`MAX_HELD_RESIDUAL`], one whose contacts all settled to [`MAX_SETTLED_RESIDUAL`].
     fn check_equilibrium(&self, step: usize) -> Result<(), Error> {
         let Some(last) = self.out.increments.last() else {
             return Ok(());
         };
+        if last.held == 0 && last.equilibrium_residual > MAX_SETTLED_RESIDUAL {
+            return Err(Error::RoundOff {
+                step,
+                residual: last.equilibrium_residual,
+                limit: MAX_SETTLED_RESIDUAL,
+            });
+        }
         if last.held == 0 || !(last.equilibrium_residual > MAX_HELD_RESIDUAL) {
             return Ok(());
         }

@@ -163,6 +163,14 @@ pub const MAX_CONTACT_RECORDS: usize = 50_000_000;
 /// open or slide under shear: its resultants then grew to 10¹⁴³).
 pub const MAX_HELD_RESIDUAL: f64 = 0.1;
 
+/// The equilibrium residual above which an increment whose contacts all settled (none held)
+/// is an error ([`crate::Error::RoundOff`]) rather than a result. Settled increments end at
+/// 10⁻¹⁰–3·10⁻⁹ on every generated cell, at the round-off floor of 1–2·10⁻⁸ on the L
+/// non-woven; above that the penalties' round-off shows: the crossing beams of
+/// `tests/contact_validation.rs` reach 2.7·10⁻⁷ at 10⁷ × the default penalty (the force
+/// 2·10⁻⁶ off its closed form), 7·10⁻⁶ at 10⁸, and 0.12 at 10¹² with the force 100 % off.
+pub const MAX_SETTLED_RESIDUAL: f64 = 1e-6;
+
 /// The default of [`IncrementalOptions::max_cutbacks`]: down to 1/16 of an increment.
 pub const MAX_CUTBACKS: usize = 4;
 
