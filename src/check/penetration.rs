@@ -7,10 +7,10 @@
 //! cell problem at a macroscopic strain of the requested size (curvatures κ = 2ε/h, the strain
 //! ε at the fabric's faces), the overlap a contact starts with, max(−ḡ, 0), plus |δg| under it.
 
-use crate::contact::{BlockVector, ContactOrigin, ContactPair, ContactState};
+use crate::contact::{ContactOrigin, ContactPair, ContactState};
 use crate::homogenize::PeriodicSystem;
 use crate::model::Model;
-use crate::solve::{solve_incremental, IncrementalOptions, SolveOptions};
+use crate::solve::{gather, solve_incremental, IncrementalOptions, SolveOptions};
 use crate::Error;
 use serde::Serialize;
 use std::collections::HashMap;
@@ -90,13 +90,7 @@ fn worst_case(
 
 /// n·B q of `pair` for the generalized displacements `q`: the change of its penetration.
 fn normal_jump(pair: &ContactPair, q: &[f64]) -> f64 {
-    let mut v = BlockVector::zeros();
-    for (k, &n) in pair.jump.nodes.iter().enumerate() {
-        for d in 0..6 {
-            v[6 * k + d] = q[6 * n + d];
-        }
-    }
-    pair.kinematics(&v).penetration + pair.gap
+    pair.kinematics(&gather(q, &pair.jump.nodes)).penetration + pair.gap
 }
 
 /// The names of the six macroscopic quantities.

@@ -9,7 +9,7 @@
 
 use crate::homogenize::StickSystem;
 use crate::model::{Dof, Support};
-use crate::solve::{SolveOptions, SolverKind};
+use crate::solve::{node_roots, SolveOptions, SolverKind};
 use crate::solver::SolverError;
 use crate::{Error, Model};
 use serde::Serialize;
@@ -30,37 +30,20 @@ pub struct RigidModes {
 
 /// The connected piece of every node (0-based, in order of first node) and their count.
 fn pieces(model: &Model, sys: &StickSystem) -> (Vec<usize>, usize) {
-    let mut parent: Vec<usize> = (0..model.nodes.len()).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
-    let mut join = |nodes: &[usize]| {
-        for w in nodes.windows(2) {
-            let (a, b) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
-            parent[a.max(b)] = a.min(b);
-        }
-    };
-    for e in model.elements() {
-        join(&e.nodes);
-    }
-    for c in &sys.contacts {
-        join(&c.jump.nodes);
-    }
-    let mut label = vec![usize::MAX; model.nodes.len()];
+    let links: Vec<&[usize]> = sys.contacts.iter().map(|c| &c.jump.nodes[..]).collect();
+    let roots = node_roots(model, &links);
+    let mut label = vec![usize::MAX; roots.len()];
     let mut count = 0;
-    let mut piece = vec![0; model.nodes.len()];
-    for (i, p) in piece.iter_mut().enumerate() {
-        let r = root(&mut parent, i);
-        if label[r] == usize::MAX {
-            label[r] = count;
-            count += 1;
-        }
-        *p = label[r];
-    }
+    let piece = roots
+        .iter()
+        .map(|&r| {
+            if label[r] == usize::MAX {
+                label[r] = count;
+                count += 1;
+            }
+            label[r]
+        })
+        .collect();
     (piece, count)
 }
 

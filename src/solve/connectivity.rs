@@ -21,9 +21,15 @@ pub fn check_supported(model: &Model) -> Result<(), Error> {
     check_supported_with(model, &[])
 }
 
-/// Like [`check_supported`], with extra groups of nodes joined (the blocks of the contacts that
-/// are currently closed): a fiber held only by open contacts is reported.
-pub fn check_supported_with(model: &Model, links: &[&[usize]]) -> Result<(), Error> {
+/// The root of every node's connected group: nodes joined by the elements and by each group of
+/// `links` (contact blocks).
+pub(crate) fn node_roots(model: &Model, links: &[&[usize]]) -> Vec<usize> {
+    let mut parent = joined(model, links);
+    (0..parent.len()).map(|i| find(&mut parent, i)).collect()
+}
+
+/// The union-find forest of the nodes joined by the elements and by each group of `links`.
+fn joined(model: &Model, links: &[&[usize]]) -> Vec<usize> {
     let n = model.nodes.len();
     let mut parent: Vec<usize> = (0..n).collect();
     let join = |parent: &mut Vec<usize>, x: usize, y: usize| {
@@ -40,6 +46,14 @@ pub fn check_supported_with(model: &Model, links: &[&[usize]]) -> Result<(), Err
             join(&mut parent, w[0], w[1]);
         }
     }
+    parent
+}
+
+/// Like [`check_supported`], with extra groups of nodes joined (the blocks of the contacts that
+/// are currently closed): a fiber held only by open contacts is reported.
+pub fn check_supported_with(model: &Model, links: &[&[usize]]) -> Result<(), Error> {
+    let n = model.nodes.len();
+    let mut parent = joined(model, links);
     let mut supported = vec![false; n];
     for s in &model.supports {
         let r = find(&mut parent, s.node);

@@ -13,9 +13,10 @@ mod reduced;
 mod static_solve;
 
 pub use backend::{SolverConfig, SolverKind};
+pub(crate) use connectivity::node_roots;
 pub use connectivity::{check_supported, check_supported_with};
 pub use increment_timings::IncrementTimings;
-pub(crate) use incremental::{run_incremental, Advanced, OnAllStick, RunState, Setup};
+pub(crate) use incremental::{gather, run_incremental, Advanced, OnAllStick, RunState, Setup};
 pub use incremental::{
     solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
     IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, ProgressFn, BOUND_TOLERANCE,

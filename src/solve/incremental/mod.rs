@@ -65,6 +65,7 @@ use increment::Increment;
 use load_path::LoadPath;
 use matrix_values::MatrixValues;
 use options::CHATTER_SWITCHES;
+pub(crate) use return_mapping::gather;
 pub(crate) use run_state::{Advanced, RunState};
 pub(crate) use setup::Setup;
 

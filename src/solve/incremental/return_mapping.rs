@@ -170,7 +170,7 @@ pub(super) fn unsettled_force(
 }
 
 /// The 30-vector of `q` at `nodes` (six DOFs each), the block displacement of a contact.
-pub(super) fn gather(q: &[f64], nodes: &[usize]) -> BlockVector {
+pub(crate) fn gather(q: &[f64], nodes: &[usize]) -> BlockVector {
     let mut v = BlockVector::zeros();
     for (k, &n) in nodes.iter().enumerate() {
         for d in 0..6 {
