@@ -86,7 +86,8 @@ impl StickSlip<'_, '_, '_> {
     }
 
     /// Merges the records of the two halves (and the `attempt` on the whole) into the second
-    /// half's: its state at the end, the work of all.
+    /// half's: its state at the end, the work of all, the larger residual and held count of the
+    /// halves.
     fn merge_last_two(&mut self, attempt: Option<IncrementRecord>) {
         let out = &mut self.out;
         let n = out.increments.len();
@@ -107,6 +108,9 @@ impl StickSlip<'_, '_, '_> {
             last.low_rank.largest_order = last.low_rank.largest_order.max(r.low_rank.largest_order);
         }
         last.cutbacks += first.cutbacks + 1;
+        // The larger of the halves' residuals and held counts: a record saying "nothing held"
+        // beside a residual that holding left in the first half would hide its cause.
         last.equilibrium_residual = last.equilibrium_residual.max(first.equilibrium_residual);
+        last.held = last.held.max(first.held);
     }
 }

@@ -40,7 +40,7 @@ pub struct IncrementRecord {
     pub dissipated: f64,
     /// Contacts that chattered (changed state or slip direction 4 times in this increment: the
     /// discrete penalty problem can have no consistent state for them) and were then held in
-    /// their state for the rest of it.
+    /// their state for the rest of it (of a halved increment: the most either half held).
     pub held: usize,
     /// Backend of the last solve.
     pub backend: String,
