@@ -3,8 +3,8 @@
 //! the solve did not match.
 
 use super::options::{
-    BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE, SETTLE_BY_EQUILIBRIUM_AFTER,
-    STALLED_EQUILIBRIUM_TOLERANCE,
+    BOUND_TOLERANCE, EARLY_EQUILIBRIUM_TOLERANCE, EARLY_SETTLE_AFTER, EQUILIBRIUM_TOLERANCE,
+    SETTLE_BY_EQUILIBRIUM_AFTER, STALLED_EQUILIBRIUM_TOLERANCE,
 };
 use super::return_mapping::{classify, gather, hold, unsettled_force, Trial};
 use super::StickSlip;
@@ -49,7 +49,8 @@ impl StickSlip<'_, '_, '_> {
     /// [`SETTLE_BY_EQUILIBRIUM_AFTER`] on, they only say that sliding forces are off the law
     /// (no state, slip direction or sign of N moved) while the increment to load factor
     /// `alpha` is in equilibrium with the law's forces to [`EQUILIBRIUM_TOLERANCE`], or its
-    /// residual stalled within twice that (`floor`): the displacements are then a solution,
+    /// residual stalled within twice that (`floor`); from [`EARLY_SETTLE_AFTER`] on, to
+    /// [`EARLY_EQUILIBRIUM_TOLERANCE`]: the displacements are then a solution,
     /// whatever the linearization still says (on large cells the per-contact test asks the
     /// tangential displacements for more digits than the solves carry).
     pub(super) fn classify_settled(
@@ -59,12 +60,17 @@ impl StickSlip<'_, '_, '_> {
         floor: &mut ResidualFloor,
     ) -> Classified {
         let mut classified = self.classify();
-        if iteration >= SETTLE_BY_EQUILIBRIUM_AFTER
+        if iteration >= EARLY_SETTLE_AFTER
             && !classified.changed.is_empty()
             && classified.forces_only
         {
             let r = self.equilibrium_residual(alpha, &classified.trials);
-            if r <= EQUILIBRIUM_TOLERANCE || floor.stalled(iteration, r) {
+            let settled = if iteration < SETTLE_BY_EQUILIBRIUM_AFTER {
+                r <= EARLY_EQUILIBRIUM_TOLERANCE
+            } else {
+                r <= EQUILIBRIUM_TOLERANCE || floor.stalled(iteration, r)
+            };
+            if settled {
                 classified.changed.clear();
             }
         }
