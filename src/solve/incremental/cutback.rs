@@ -86,8 +86,7 @@ impl StickSlip<'_, '_, '_> {
     }
 
     /// Merges the records of the two halves (and the `attempt` on the whole) into the second
-    /// half's: its state at the end, the work of all, the larger residual and held count of the
-    /// halves.
+    /// half's (see [`merge_halves`]).
     fn merge_last_two(&mut self, attempt: Option<IncrementRecord>) {
         let out = &mut self.out;
         let n = out.increments.len();
@@ -97,20 +96,62 @@ impl StickSlip<'_, '_, '_> {
         let first = out.increments.remove(n - 2);
         out.contact_results.remove(n - 2);
         out.displacements.remove(n - 2);
-        let last = out.increments.last_mut().expect("two records");
-        for r in std::iter::once(&first).chain(attempt.as_ref()) {
-            last.iterations += r.iterations;
-            last.factorizations += r.factorizations;
-            last.factor_reuses += r.factor_reuses;
-            last.reuse_iterations += r.reuse_iterations;
-            last.seconds += r.seconds;
-            last.timings.add(&r.timings);
-            last.low_rank.largest_order = last.low_rank.largest_order.max(r.low_rank.largest_order);
+        if let Some(last) = out.increments.last_mut() {
+            merge_halves(last, &first, attempt.as_ref());
         }
-        last.cutbacks += first.cutbacks + 1;
-        // The larger of the halves' residuals and held counts: a record saying "nothing held"
-        // beside a residual that holding left in the first half would hide its cause.
-        last.equilibrium_residual = last.equilibrium_residual.max(first.equilibrium_residual);
-        last.held = last.held.max(first.held);
+    }
+}
+
+/// The record of a halved increment from its halves' (`first`, `last`) and the `attempt` on
+/// the whole, into `last`: the state at the end, the work of all, the larger residual and held
+/// count of the halves (a record saying "nothing held" beside a residual that holding left in
+/// the first half would hide its cause).
+fn merge_halves(
+    last: &mut IncrementRecord,
+    first: &IncrementRecord,
+    attempt: Option<&IncrementRecord>,
+) {
+    for r in std::iter::once(first).chain(attempt) {
+        last.iterations += r.iterations;
+        last.factorizations += r.factorizations;
+        last.factor_reuses += r.factor_reuses;
+        last.reuse_iterations += r.reuse_iterations;
+        last.seconds += r.seconds;
+        last.timings.add(&r.timings);
+        last.low_rank.largest_order = last.low_rank.largest_order.max(r.low_rank.largest_order);
+    }
+    last.cutbacks += first.cutbacks + 1;
+    last.equilibrium_residual = last.equilibrium_residual.max(first.equilibrium_residual);
+    last.held = last.held.max(first.held);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{merge_halves, IncrementRecord};
+
+    /// As L seed 3 under e22 at α = 0.45: a first half that ended with 3 contacts held at
+    /// residual 8·10⁻⁵ and a second that settled. The merged record reports both the residual
+    /// and the held contacts (before: "held 0" beside 8·10⁻⁵), sums the work of the halves and
+    /// the failed attempt, and counts the halving.
+    #[test]
+    fn the_merged_record_keeps_the_held_contacts_of_the_worse_half() {
+        let record = |iterations, held, residual| IncrementRecord {
+            iterations,
+            held,
+            equilibrium_residual: residual,
+            ..IncrementRecord::default()
+        };
+        let first = record(40, 3, 8e-5);
+        let attempt = record(50, 120, 2e-4);
+        let mut last = record(6, 0, 1e-10);
+        merge_halves(&mut last, &first, Some(&attempt));
+        assert_eq!(last.held, 3);
+        assert_eq!(last.equilibrium_residual, 8e-5);
+        assert_eq!(last.iterations, 96);
+        assert_eq!(last.cutbacks, 1);
+
+        let mut settled = record(6, 0, 1e-10);
+        merge_halves(&mut settled, &record(5, 0, 2e-10), None);
+        assert_eq!((settled.held, settled.equilibrium_residual), (0, 2e-10));
     }
 }

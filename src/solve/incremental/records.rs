@@ -7,7 +7,7 @@ use serde::Serialize;
 use std::sync::Arc;
 
 /// One increment.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct IncrementRecord {
     /// Increment n (1-based).
     pub step: usize,
