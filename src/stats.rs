@@ -1,7 +1,7 @@
 //! Statistics of a fiber network: fiber count, total length, solid volume fraction,
 //! orientation tensor, contacts and the mean free segment length between contacts.
 
-use crate::cell::{pair_boundary_nodes, Periodicity};
+use crate::cell::{pair_boundary_nodes, strand_of_fibers, Periodicity};
 use crate::contact::ContactSet;
 use crate::model::Model;
 use crate::Error;
@@ -152,45 +152,12 @@ pub fn orientation_histogram(model: &Model, bins: usize) -> Vec<f64> {
     h
 }
 
-/// Physical fibers: pieces joined end to end through paired boundary nodes (a slave node that
-/// ends one piece and whose master ends another) count once — as a chain, or as a ring for a
-/// yarn that runs around the cell.
+/// Physical fibers: pieces that continue one another end to end (through paired boundary
+/// nodes, or at a node only they share) count once — as a chain, or as a ring for a yarn that
+/// runs around the cell.
 fn physical_fibers(model: &Model, periodic: Option<&Periodicity>) -> usize {
-    let n = model.nodes.len();
-    // The piece each node ends (None: no end, or the end of several pieces — a junction).
-    let mut end_of: Vec<Option<usize>> = vec![None; n];
-    let mut ends = vec![0u32; n];
-    for (k, f) in model.fibers.iter().enumerate() {
-        if let (Some(&a), Some(&b)) = (f.nodes.first(), f.nodes.last()) {
-            for e in [a, b] {
-                ends[e] += 1;
-                end_of[e] = Some(k);
-            }
-        }
-    }
-    let mut parent: Vec<usize> = (0..model.fibers.len()).collect();
-    fn root(parent: &mut [usize], mut k: usize) -> usize {
-        while parent[k] != k {
-            parent[k] = parent[parent[k]];
-            k = parent[k];
-        }
-        k
-    }
-    if let Some(p) = periodic {
-        for (slave, m) in p.master.iter().enumerate() {
-            if let Some((master, _)) = *m {
-                if let (1, 1, Some(a), Some(b)) =
-                    (ends[slave], ends[master], end_of[slave], end_of[master])
-                {
-                    let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-                    parent[ra] = rb;
-                }
-            }
-        }
-    }
-    (0..parent.len())
-        .filter(|&k| root(&mut parent, k) == k)
-        .count()
+    let strands = strand_of_fibers(model, periodic);
+    (0..strands.len()).filter(|&f| strands[f] == f).count()
 }
 
 impl NetworkStats {

@@ -4,7 +4,7 @@
 use super::{
     find_candidates, jump_operator, tangent_basis, Candidate, ContactPair, ContactSide, Jump,
 };
-use crate::cell::Periodicity;
+use crate::cell::{strand_of_fibers, Periodicity};
 use crate::element::local_frame;
 use crate::model::{Model, ModelError, PenetrationSpec};
 use nalgebra::Vector3;
@@ -204,18 +204,20 @@ fn side_of(model: &Model, element: usize, xi: f64) -> ContactSide {
 
 /// One crossing of two fibers is seen by every pair of their elements near it (two or four
 /// when it lies at or near element ends, and in a cell possibly once on each side of the
-/// boundary). Per pair of fibers, candidates whose contact points lie within the sum of the two
-/// diameters of a closer one — positions compared modulo the periods — are the same contact and
-/// dropped.
+/// boundary, or on both pieces of a fiber cut at the boundary). Per pair of strands (fibers
+/// continued end to end, [`strand_of_fibers`]), candidates whose contact points lie within the
+/// sum of the two diameters of a closer one — positions compared modulo the periods — are the
+/// same contact and dropped.
 fn merge_duplicates(
     model: &Model,
     cell: Option<&Periodicity>,
     mut found: Vec<Candidate>,
 ) -> Vec<Candidate> {
     let period = cell.map_or([0.0; 2], |p| p.geometry.size);
-    let fiber = |e: usize| model.elements()[e].fiber;
+    let strands = strand_of_fibers(model, cell);
+    let strand = |e: usize| strands[model.elements()[e].fiber];
     let key = |x: &Candidate| {
-        let (a, b) = (fiber(x.elements[0]), fiber(x.elements[1]));
+        let (a, b) = (strand(x.elements[0]), strand(x.elements[1]));
         (a.min(b), a.max(b))
     };
     let point = |e: usize, xi: f64, shift: [i32; 2]| {
@@ -276,7 +278,7 @@ fn merge_duplicates(
         }
     }
     for (k, twins) in kept.iter_mut().zip(&twins) {
-        if let Some(at_nodes) = straddled_nodes(model, period, k, twins) {
+        if let Some(at_nodes) = straddled_nodes(model, (period, &strands), k, twins) {
             *k = at_nodes;
         }
     }
@@ -291,17 +293,17 @@ fn merge_duplicates(
 /// lie on both elements at a node of each fiber, the contact is placed at the two nodes.
 fn straddled_nodes(
     model: &Model,
-    period: [f64; 2],
+    (period, strands): ([f64; 2], &[usize]),
     kept: &Candidate,
     twins: &[Candidate],
 ) -> Option<Candidate> {
     let els = model.elements();
     let fiber = |e: usize| els[e].fiber;
     let tol = 1e-9 * kept.distance.abs().max(f64::MIN_POSITIVE);
-    // The near-equal candidates, oriented like `kept` (side I on kept's first fiber).
+    // The near-equal candidates, oriented like `kept` (side I on kept's first strand).
     let mut same: Vec<([usize; 2], [i32; 2])> = vec![(kept.elements, kept.shift)];
     for t in twins.iter().filter(|t| t.distance <= kept.distance + tol) {
-        if fiber(t.elements[0]) == fiber(kept.elements[0]) {
+        if strands[fiber(t.elements[0])] == strands[fiber(kept.elements[0])] {
             same.push((t.elements, t.shift));
         } else {
             same.push(([t.elements[1], t.elements[0]], [-t.shift[0], -t.shift[1]]));
