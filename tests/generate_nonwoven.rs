@@ -51,7 +51,7 @@ fn the_same_seed_gives_the_same_cell() {
 #[test]
 fn cells_are_periodic_and_contacts_cross_the_faces() {
     // A fiber leaving the cell is written as pieces, so most crossings near a face are seen
-    // inside the cell, and their images are the same crossings (merged, tests/seam_crossing.rs);
+    // inside the cell, and their images are the same crossings (merged, tests/one_contact_per_crossing.rs);
     // in this cell three contacts are closest between an element and a periodic image.
     let p = small(3);
     let m = model(&p);

@@ -3,6 +3,7 @@
 //! stick/slip states.
 
 mod coefficients;
+mod duplicates;
 mod geometry;
 mod kinematics;
 mod law;

@@ -1,10 +1,9 @@
 //! The contact pairs of a model: searched candidates and explicit pairs, with their normals,
 //! tangent bases, gaps and penalties; initially penetrating pairs are counted and handled.
 
-use super::{
-    find_candidates, jump_operator, tangent_basis, Candidate, ContactPair, ContactSide, Jump,
-};
-use crate::cell::{strand_of_fibers, Periodicity};
+use super::duplicates::merge_duplicates;
+use super::{find_candidates, jump_operator, tangent_basis, ContactPair, ContactSide, Jump};
+use crate::cell::Periodicity;
 use crate::element::local_frame;
 use crate::model::{Model, ModelError, PenetrationSpec};
 use nalgebra::Vector3;
@@ -200,152 +199,6 @@ fn side_of(model: &Model, element: usize, xi: f64) -> ContactSide {
     } else {
         ContactSide::Point { element, xi }
     }
-}
-
-/// One crossing of two fibers is seen by every pair of their elements near it (two or four
-/// when it lies at or near element ends, and in a cell possibly once on each side of the
-/// boundary, or on both pieces of a fiber cut at the boundary). Per pair of strands (fibers
-/// continued end to end, [`strand_of_fibers`]), candidates whose contact points lie within the
-/// sum of the two diameters of a closer one — positions compared modulo the periods — are the
-/// same contact and dropped.
-fn merge_duplicates(
-    model: &Model,
-    cell: Option<&Periodicity>,
-    mut found: Vec<Candidate>,
-) -> Vec<Candidate> {
-    let period = cell.map_or([0.0; 2], |p| p.geometry.size);
-    let strands = strand_of_fibers(model, cell);
-    let strand = |e: usize| strands[model.elements()[e].fiber];
-    let key = |x: &Candidate| {
-        let (a, b) = (strand(x.elements[0]), strand(x.elements[1]));
-        (a.min(b), a.max(b))
-    };
-    let point = |e: usize, xi: f64, shift: [i32; 2]| {
-        let el = model.elements()[e];
-        let (p, q) = (
-            Vector3::from(model.nodes[el.nodes[0]].x),
-            Vector3::from(model.nodes[el.nodes[1]].x),
-        );
-        let offset = Vector3::new(
-            f64::from(shift[0]) * period[0],
-            f64::from(shift[1]) * period[1],
-            0.0,
-        );
-        p + (q - p) * xi + offset
-    };
-    // A difference of positions reduced to the nearest period.
-    let wrap = |mut d: Vector3<f64>| {
-        for k in 0..2 {
-            if period[k] > 0.0 {
-                d[k] -= period[k] * (d[k] / period[k]).round();
-            }
-        }
-        d
-    };
-    found.sort_by(|a, b| {
-        key(a)
-            .cmp(&key(b))
-            .then(a.distance.total_cmp(&b.distance))
-            .then(a.elements.cmp(&b.elements))
-            .then(a.shift.cmp(&b.shift))
-    });
-    let mut kept: Vec<Candidate> = Vec::with_capacity(found.len());
-    // The candidates merged into each kept one.
-    let mut twins: Vec<Vec<Candidate>> = Vec::with_capacity(found.len());
-    let mut group_start = 0;
-    for c in found {
-        if kept.get(group_start).is_some_and(|g| key(g) != key(&c)) {
-            group_start = kept.len();
-        }
-        let reach = 2.0 * (c.distance - c.gap);
-        let pa = point(c.elements[0], c.xi[0], [0, 0]);
-        let pb = point(c.elements[1], c.xi[1], c.shift);
-        let duplicate = kept[group_start..].iter().position(|k| {
-            let qa = point(k.elements[0], k.xi[0], [0, 0]);
-            let qb = point(k.elements[1], k.xi[1], k.shift);
-            // Compare whichever way round the pair was found: the same first point (modulo
-            // the periods) and the same offset to the second.
-            let same = wrap(pa - qa).norm().max(((pb - pa) - (qb - qa)).norm());
-            let swapped = wrap(pa - qb).norm().max(((pb - pa) - (qa - qb)).norm());
-            same.min(swapped) < reach
-        });
-        match duplicate {
-            None => {
-                kept.push(c);
-                twins.push(Vec::new());
-            }
-            Some(i) => twins[group_start + i].push(c),
-        }
-    }
-    for (k, twins) in kept.iter_mut().zip(&twins) {
-        if let Some(at_nodes) = straddled_nodes(model, (period, &strands), k, twins) {
-            *k = at_nodes;
-        }
-    }
-    kept.sort_by_key(|c| (c.elements, c.shift));
-    kept
-}
-
-/// A crossing at a node of each fiber where both polylines kink (a woven crossover) is closest
-/// not at the nodes but a little way along the adjacent elements (a chord cuts inside the
-/// curve), at equally close element pairs on both sides of each node: keeping one of them
-/// would break the symmetry of the crossing. When the equally close candidates (within 10⁻⁹)
-/// lie on both elements at a node of each fiber, the contact is placed at the two nodes.
-fn straddled_nodes(
-    model: &Model,
-    (period, strands): ([f64; 2], &[usize]),
-    kept: &Candidate,
-    twins: &[Candidate],
-) -> Option<Candidate> {
-    let els = model.elements();
-    let fiber = |e: usize| els[e].fiber;
-    let tol = 1e-9 * kept.distance.abs().max(f64::MIN_POSITIVE);
-    // The near-equal candidates, oriented like `kept` (side I on kept's first strand).
-    let mut same: Vec<([usize; 2], [i32; 2])> = vec![(kept.elements, kept.shift)];
-    for t in twins.iter().filter(|t| t.distance <= kept.distance + tol) {
-        if strands[fiber(t.elements[0])] == strands[fiber(kept.elements[0])] {
-            same.push((t.elements, t.shift));
-        } else {
-            same.push(([t.elements[1], t.elements[0]], [-t.shift[0], -t.shift[1]]));
-        }
-    }
-    if same.len() < 2 || same.iter().any(|(_, s)| *s != kept.shift) {
-        return None;
-    }
-    // The node shared by two different elements of one side, if any.
-    let shared = |side: usize| -> Option<(usize, usize)> {
-        for (a, _) in &same {
-            for (b, _) in &same {
-                let (ea, eb) = (els[a[side]], els[b[side]]);
-                if a[side] != b[side] && ea.nodes[1] == eb.nodes[0] {
-                    return Some((a[side], ea.nodes[1]));
-                }
-            }
-        }
-        None
-    };
-    let ((ea, na), (eb, nb)) = (shared(0)?, shared(1)?);
-    let x = |n: usize| Vector3::from(model.nodes[n].x);
-    let offset = Vector3::new(
-        f64::from(kept.shift[0]) * period[0],
-        f64::from(kept.shift[1]) * period[1],
-        0.0,
-    );
-    let d = x(nb) + offset - x(na);
-    let distance = d.norm();
-    if distance <= 0.0 {
-        return None;
-    }
-    let radius = |e: usize| model.fibers[fiber(e)].section.radius;
-    let n = d / distance;
-    Some(Candidate {
-        elements: [ea, eb],
-        shift: kept.shift,
-        xi: [1.0, 1.0],
-        distance,
-        gap: distance - radius(ea) - radius(eb),
-        normal: [n[0], n[1], n[2]],
-    })
 }
 
 impl ContactSet {
