@@ -26,6 +26,7 @@ pub mod check;
 pub mod constraints;
 pub mod contact;
 pub mod element;
+pub mod ensemble;
 mod error;
 pub mod generate;
 pub mod homogenize;

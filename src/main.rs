@@ -160,6 +160,32 @@ enum Command {
         #[command(subcommand)]
         kind: GenerateKind,
     },
+    /// The scatter of a random cell's effective stiffness: N realizations of a generator with
+    /// consecutive seeds, the six cell problems of each, and per ABD entry the mean, standard
+    /// deviation and 95 % confidence interval, with the interval's convergence as N grows.
+    /// Each realization is stored in DIR/realizations as it finishes; a rerun with the same DIR
+    /// reuses them (a killed run loses no finished work).
+    Ensemble {
+        /// Non-woven preset (S, M or L) as the generator.
+        #[arg(long, conflicts_with = "params", required_unless_present = "params")]
+        preset: Option<String>,
+        /// Generator parameter file (`family = "nonwoven"` etc., as `fixtures/cells/*.params.toml`).
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Number of realizations N.
+        #[arg(short = 'n', long)]
+        realizations: usize,
+        /// Seed of the first realization; the others follow it.
+        #[arg(long, default_value_t = 1)]
+        first_seed: u64,
+        #[command(flatten)]
+        solver: SolverArgs,
+        /// Print one JSON document instead of the table.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        out: OutDir,
+    },
     /// Statistics of a model: fibers, length, volume fraction, orientation tensor, contacts.
     Stats {
         /// Model file.
@@ -928,6 +954,74 @@ fn curve(
     Ok(())
 }
 
+fn ensemble(
+    (preset, params): (Option<&str>, Option<&Path>),
+    (realizations, first_seed, solve): (usize, u64, SolveOptions),
+    json: bool,
+    out: &Path,
+) -> Result<(), Error> {
+    use fibercell::ensemble::{run_ensemble, EnsembleOptions, MAIN_MODULI};
+    use fibercell::generate::{nonwoven_preset, CellParams};
+    let (params, name) = match (preset, params) {
+        (Some(p), _) => (
+            CellParams::Nonwoven(nonwoven_preset(p, first_seed)?),
+            format!("non-woven {p}"),
+        ),
+        (None, Some(path)) => (io::read_cell_params(path)?, path.display().to_string()),
+        (None, None) => {
+            return Err(Error::InvalidOption(
+                "give the generator: --preset S|M|L or --params FILE".into(),
+            ))
+        }
+    };
+    let opts = EnsembleOptions {
+        params,
+        realizations,
+        first_seed,
+        solve,
+    };
+    let mut report = |r: &fibercell::ensemble::Realization, reused: bool| {
+        let what = match (&r.error, reused) {
+            (Some(e), _) => format!("failed: {e}"),
+            (None, true) => "reused".into(),
+            (None, false) => format!("{:.2} s", r.seconds),
+        };
+        eprintln!("seed {}: {what}", r.seed);
+    };
+    // ensemble.json is written last: a folder that holds it is complete.
+    io::begin_results(out, "ensemble.json")?;
+    let e = run_ensemble(&opts, Some(out), Some(&mut report))?;
+    let title = format!("{name}: {} realizations", e.realizations.len());
+    io::write_ensemble_files(out, &e, &title)?;
+    if json {
+        println!("{}", to_pretty(&e)?);
+        return Ok(());
+    }
+    let failed = e.failed();
+    println!(
+        "{title} (seeds {first_seed}–{}), {} failed, {} reused; results in {}",
+        first_seed + realizations as u64 - 1,
+        failed.len(),
+        e.reused,
+        out.display()
+    );
+    for k in MAIN_MODULI {
+        let x = &e.abd[k][k];
+        println!(
+            "  {}  mean {:.5e}  std {:.3e}  95 % interval ± {:.3e} ({:.2} %)",
+            io::abd_entry_name(k, k),
+            x.mean,
+            x.std,
+            x.ci95,
+            100.0 * x.relative_ci95()
+        );
+    }
+    for (seed, err) in &failed {
+        println!("  seed {seed} failed: {err}");
+    }
+    Ok(())
+}
+
 fn generate(kind: GenerateKind) -> Result<(), Error> {
     use fibercell::generate::{CellParams, FiberAmount, LengthDistribution, NonWoven};
     match kind {
@@ -1370,6 +1464,20 @@ fn main() -> ExitCode {
             &output.dir,
         ),
         Command::Generate { kind } => generate(kind),
+        Command::Ensemble {
+            preset,
+            params,
+            realizations,
+            first_seed,
+            solver,
+            json,
+            out,
+        } => ensemble(
+            (preset.as_deref(), params.as_deref()),
+            (realizations, first_seed, solver.options()),
+            json,
+            &out.dir,
+        ),
         Command::Stats { model, json, rose } => stats(&model, json, rose.as_deref()),
         Command::Convert {
             input,

@@ -49,6 +49,16 @@ impl CellParams {
         serde_json::from_value(merged).map_err(bad)
     }
 
+    /// The same parameters with the generator's seed set to `seed` (the non-woven's; the woven,
+    /// knitted and geotextile generators are deterministic, and their cells do not depend on it).
+    pub fn with_seed(&self, seed: u64) -> Self {
+        let mut p = self.clone();
+        if let CellParams::Nonwoven(n) = &mut p {
+            n.seed = seed;
+        }
+        p
+    }
+
     /// The cell.
     pub fn generate(&self) -> Result<ModelDescription, Error> {
         match self {

@@ -70,6 +70,23 @@ pub fn begin_results(dir: &Path, marker: &str) -> Result<(), Error> {
     }
 }
 
+/// Writes the result files `files` (name, contents) into `dir` in their order, each atomically,
+/// after [`begin_results`] with the last one as the marker: a folder holding it is complete.
+/// Returns their paths.
+pub fn write_results(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>, Error> {
+    if let Some((marker, _)) = files.last() {
+        begin_results(dir, marker)?;
+    }
+    files
+        .iter()
+        .map(|(name, bytes)| {
+            let path = dir.join(name);
+            write_atomic(&path, bytes)?;
+            Ok(path)
+        })
+        .collect()
+}
+
 /// Removes the temporary files of writes still under way (for a program that is being
 /// interrupted); returns how many it removed.
 pub fn remove_unfinished_outputs() -> usize {

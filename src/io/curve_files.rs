@@ -3,7 +3,6 @@
 //! all-stick line, the switches to slip circled where the pieces' lines meet).
 
 use super::plot::{LinePlot, Series};
-use super::write_atomic;
 use crate::cell::MACRO_NAMES;
 use crate::homogenize::{segment_starting_at, Curve};
 use crate::Error;
@@ -134,25 +133,20 @@ pub fn curve_plot(c: &Curve, title: &str) -> Result<(String, Vec<u8>), Error> {
 /// `dir` (created if missing), each atomically, so that a folder with `curve.json` is complete
 /// (see [`super::begin_results`]); returns their paths.
 pub fn write_curve_files(dir: &Path, c: &Curve, title: &str) -> Result<Vec<PathBuf>, Error> {
-    super::begin_results(dir, "curve.json")?;
     let json = serde_json::to_string_pretty(c).map_err(|e| Error::Output {
         path: "curve.json".into(),
         message: e.to_string(),
     })?;
     let (svg, png) = curve_plot(c, title)?;
     let (curve, switches) = (curve_csv(c), switches_csv(c));
-    let files: [(&str, &[u8]); 5] = [
-        ("curve.csv", curve.as_bytes()),
-        ("switches.csv", switches.as_bytes()),
-        ("curve.svg", svg.as_bytes()),
-        ("curve.png", &png),
-        ("curve.json", json.as_bytes()),
-    ];
-    let mut written = Vec::new();
-    for (name, bytes) in files {
-        let path = dir.join(name);
-        write_atomic(&path, bytes)?;
-        written.push(path);
-    }
-    Ok(written)
+    super::write_results(
+        dir,
+        &[
+            ("curve.csv", curve.as_bytes()),
+            ("switches.csv", switches.as_bytes()),
+            ("curve.svg", svg.as_bytes()),
+            ("curve.png", &png),
+            ("curve.json", json.as_bytes()),
+        ],
+    )
 }

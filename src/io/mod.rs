@@ -7,6 +7,7 @@ mod abaqus_export;
 mod atomic;
 mod catalog;
 mod curve_files;
+mod ensemble_files;
 mod inp_number;
 mod job_system;
 mod matrix_market;
@@ -18,12 +19,13 @@ mod vtk;
 pub use crate::input_error::InputError;
 pub use abaqus::{parse_abaqus, MAX_GENERATED_MEMBERS};
 pub use abaqus_export::{to_abaqus, to_inp, InpFlavour, InpOptions};
-pub use atomic::{begin_results, remove_unfinished_outputs, write_atomic};
+pub use atomic::{begin_results, remove_unfinished_outputs, write_atomic, write_results};
 pub use catalog::{cell_digest, read_cell_params, reference_results, ReferenceResults};
 pub use curve_files::{
     curve_csv, curve_plot, dominant_component, switches_csv, write_curve_files, RESULTANT_NAMES,
     RESULTANT_UNITS, STRAIN_UNITS,
 };
+pub use ensemble_files::{abd_entry_name, convergence_csv, ensemble_csv, write_ensemble_files};
 pub use inp_number::{inp_number, MAX_FIELD};
 pub use job_system::{job_system, JobSystem};
 pub use matrix_market::{write_job_system, write_matrix_market, write_matrix_market_dense};
