@@ -7,6 +7,7 @@ mod percolation;
 mod strands;
 
 pub use macro_field::{macro_matrix, parse_macro_strain, MacroStrain, MACRO_NAMES};
+pub(crate) use pairing::independent_node;
 pub use pairing::{anchor_node, pair_boundary_nodes, CellError, CellGeometry, Periodicity};
 pub use percolation::check_percolation;
 pub(crate) use strands::strand_of_fibers;

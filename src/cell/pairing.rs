@@ -53,6 +53,11 @@ impl Periodicity {
     }
 }
 
+/// The independent node of node `n`: its master in a cell, itself outside one.
+pub(crate) fn independent_node(cell: Option<&Periodicity>, n: usize) -> usize {
+    cell.and_then(|p| p.master[n]).map_or(n, |(m, _)| m)
+}
+
 /// Pairs every node on the faces x = x₀ + L_x and y = y₀ + L_y with a node on the opposite
 /// face at the same other coordinates; fails naming unpaired, ambiguous or outside nodes.
 pub fn pair_boundary_nodes(model: &Model) -> Result<Periodicity, CellError> {

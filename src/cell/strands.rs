@@ -5,7 +5,7 @@
 //! search sees it on both pieces (the contact search merges duplicates per pair of strands),
 //! and the pieces are one physical fiber (the statistics count strands).
 
-use super::Periodicity;
+use super::{independent_node, Periodicity};
 use crate::model::Model;
 
 /// The strand of every fiber (an index shared by the fibers of one strand): two fibers are
@@ -13,7 +13,7 @@ use crate::model::Model;
 /// node), and nothing else meets there — a continuation, not a junction of several yarns, whose
 /// branches cross other fibers at distinct points however close.
 pub(crate) fn strand_of_fibers(model: &Model, cell: Option<&Periodicity>) -> Vec<usize> {
-    let canonical = |n: usize| cell.and_then(|p| p.master[n]).map_or(n, |(m, _)| m);
+    let canonical = |n: usize| independent_node(cell, n);
     // Element ends at each independent node, and the fibers that end there.
     let mut degree = vec![0u32; model.nodes.len()];
     for e in model.elements() {

@@ -3,8 +3,9 @@
 //! pieces of a fiber cut at the boundary, and once per yarn where a fiber lies across a junction
 //! of several. These passes keep one candidate per crossing.
 
-use super::Candidate;
-use crate::cell::{strand_of_fibers, Periodicity};
+use super::set::side_of;
+use super::{Candidate, ContactSide};
+use crate::cell::{independent_node, strand_of_fibers, Periodicity};
 use crate::model::Model;
 use nalgebra::Vector3;
 
@@ -49,18 +50,13 @@ impl Places<'_> {
         d
     }
 
-    /// The independent node a side is at, if its point is an element end.
+    /// The independent node a side is at, if its point is an element end (the node itself,
+    /// [`side_of`]).
     fn node_of_side(&self, c: &Candidate, side: usize) -> Option<usize> {
-        let el = self.model.elements()[c.elements[side]];
-        let xi = c.xi[side];
-        let n = if xi <= 1e-9 {
-            el.nodes[0]
-        } else if xi >= 1.0 - 1e-9 {
-            el.nodes[1]
-        } else {
-            return None;
-        };
-        Some(self.canonical[n])
+        match side_of(self.model, c.elements[side], c.xi[side]) {
+            ContactSide::Node(n) => Some(self.canonical[n]),
+            ContactSide::Point { .. } => None,
+        }
     }
 }
 
@@ -75,7 +71,7 @@ pub(super) fn merge_duplicates(
         model,
         period: cell.map_or([0.0; 2], |p| p.geometry.size),
         canonical: (0..model.nodes.len())
-            .map(|n| cell.and_then(|p| p.master[n]).map_or(n, |(m, _)| m))
+            .map(|n| independent_node(cell, n))
             .collect(),
     };
     let strands = strand_of_fibers(model, cell);

@@ -190,7 +190,7 @@ fn surface_jump(
 
 /// A contact point at an element end is the node itself (the interpolation there is exactly the
 /// nodal translation), so that the same crossing seen from two adjacent elements is one side.
-fn side_of(model: &Model, element: usize, xi: f64) -> ContactSide {
+pub(super) fn side_of(model: &Model, element: usize, xi: f64) -> ContactSide {
     let e = model.elements()[element];
     if xi <= 1e-9 {
         ContactSide::Node(e.nodes[0])
