@@ -126,6 +126,7 @@ impl RunState {
                 a,
                 symmetric: !nonsymmetric,
                 b,
+                target: REUSE_ACCURACY * backward_tolerance(&setup.opts.solve),
                 tolerance: REUSE_ACCURACY * backward_tolerance(&setup.opts.solve),
             };
             match refine_low_rank(&low_rank, a0.as_mut(), &cap, &check, first).map_err(locate)? {

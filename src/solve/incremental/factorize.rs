@@ -141,6 +141,8 @@ impl StickSlip<'_, '_, '_> {
         if refactorized {
             // The reference's own load: A₀⁻¹ b₀ of this increment.
             factors.reference_solution = Some(Reference::Full(x.clone()));
+            factors.reference_backward_error = Some(r.backward_error);
+            factors.reference_step = Some(inc.step);
         }
         Ok((x, Some(r)))
     }

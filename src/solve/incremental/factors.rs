@@ -91,6 +91,11 @@ pub(super) struct Factors {
     pub low_rank: LowRankCorrection,
     /// The references of earlier increments' b₀ on it, when b₀ is affine in α.
     pub affine: AffineReferences,
+    /// The backward error of the reference's own direct solve: what a low-rank solve on it
+    /// must come close to (see [`super::options::LOW_RANK_MATCH`]).
+    pub reference_backward_error: Option<f64>,
+    /// The increment whose solve factorized the reference.
+    pub reference_step: Option<usize>,
 }
 
 impl Factors {
@@ -107,6 +112,8 @@ impl Factors {
             reference_solution: None,
             low_rank: LowRankCorrection::new(n_free, contacts),
             affine: AffineReferences::default(),
+            reference_backward_error: None,
+            reference_step: None,
         }
     }
 

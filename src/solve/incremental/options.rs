@@ -202,6 +202,18 @@ pub(super) const SLIP_DIRECTION_TOLERANCE: f64 = 1e-10;
 /// barely sliding contacts wandered by 1e-3 between iterations (measured on the S cell).
 pub(super) const REUSE_ACCURACY: f64 = 1e-5;
 
+/// How far a low-rank solve's backward error may stay above that of the reference
+/// factorization's own direct solve. [`REUSE_ACCURACY`] alone accepted low-rank solves 300–500
+/// times less accurate than the direct ones: on the L non-woven (seed 3) unloaded under e11,
+/// from the reversal on, the correction adds the stick springs of thousands of contacts that
+/// slid in the reference, its solves were accepted at backward errors of 5·10⁻¹⁷–1.4·10⁻¹⁶
+/// against 2·10⁻¹⁹ for Cholesky, and the strict equilibrium residual rose from 5·10⁻⁹ to
+/// 0.8–1.8·10⁻⁷ (reported 1.7–5·10⁻⁸), with stalls and cutbacks. The M non-woven's low-rank
+/// solves reach 10⁻¹⁹ in their first step. A solve that stops short of it after
+/// [`MAX_REFINEMENTS`] steps is kept if it meets [`REUSE_ACCURACY`], and the next solve
+/// refactorizes: a fresh reference for the states the correction had drifted to.
+pub(super) const LOW_RANK_MATCH: f64 = 10.0;
+
 /// Columns of the low-rank correction kept on one factorization before refactorizing, by
 /// default: S, their dense products, then takes 8 bytes × this squared (512 MB).
 pub const MAX_LOW_RANK_COLUMNS: usize = 8192;
