@@ -178,6 +178,16 @@ enum Command {
         /// Seed of the first realization; the others follow it.
         #[arg(long, default_value_t = 1)]
         first_seed: u64,
+        /// Also the elasto-plastic curve of each realization to this macroscopic strain (as
+        /// `curve --strain`), with per point the mean and 95 % interval of the resultants.
+        #[arg(long, value_parser = parse_strain)]
+        strain: Option<fibercell::cell::MacroStrain>,
+        /// Increments of the curves' loading branch.
+        #[arg(long, default_value_t = 100, requires = "strain")]
+        steps: usize,
+        /// Unload the curves to zero and reload.
+        #[arg(long, requires = "strain")]
+        unload: bool,
         #[command(flatten)]
         solver: SolverArgs,
         /// Print one JSON document instead of the table.
@@ -957,6 +967,7 @@ fn curve(
 fn ensemble(
     (preset, params): (Option<&str>, Option<&Path>),
     (realizations, first_seed, solve): (usize, u64, SolveOptions),
+    curve: Option<fibercell::ensemble::CurvePath>,
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
@@ -979,6 +990,7 @@ fn ensemble(
         realizations,
         first_seed,
         solve,
+        curve,
     };
     let mut report = |r: &fibercell::ensemble::Realization, reused: bool| {
         let what = match (&r.error, reused) {
@@ -1015,6 +1027,26 @@ fn ensemble(
             x.ci95,
             100.0 * x.relative_ci95()
         );
+    }
+    if let Some(c) = &e.curve {
+        let k = c.component;
+        if let Some(peak) = c.points.get(c.path.steps.saturating_sub(1)) {
+            let x = &peak.resultant[k];
+            println!(
+                "  curves: {} of {} complete; at {} = {:.4e}: {}  mean {:.5e} {}  std {:.3e}  \
+                 95 % interval ± {:.3e} ({:.2} %)",
+                c.curves,
+                e.realizations.len(),
+                fibercell::cell::MACRO_NAMES[k],
+                peak.strain[k],
+                io::RESULTANT_NAMES[k],
+                x.mean,
+                io::RESULTANT_UNITS[k],
+                x.std,
+                x.ci95,
+                100.0 * x.relative_ci95()
+            );
+        }
     }
     for (seed, err) in &failed {
         println!("  seed {seed} failed: {err}");
@@ -1469,12 +1501,20 @@ fn main() -> ExitCode {
             params,
             realizations,
             first_seed,
+            strain,
+            steps,
+            unload,
             solver,
             json,
             out,
         } => ensemble(
             (preset.as_deref(), params.as_deref()),
             (realizations, first_seed, solver.options()),
+            strain.map(|strain| fibercell::ensemble::CurvePath {
+                strain,
+                steps,
+                unload,
+            }),
             json,
             &out.dir,
         ),

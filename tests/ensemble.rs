@@ -29,6 +29,7 @@ fn options(params: CellParams, realizations: usize) -> EnsembleOptions {
         realizations,
         first_seed: 1,
         solve: SolveOptions::default(),
+        curve: None,
     }
 }
 
@@ -130,4 +131,123 @@ fn a_killed_cli_run_restarts_where_it_stopped() {
     assert!(run(&whole).output().unwrap().status.success());
     let table = |d: &Path| std::fs::read_to_string(d.join("ensemble.csv")).unwrap();
     assert_eq!(table(&killed), table(&whole));
+}
+
+/// Curves in an ensemble: per point the statistics of the realizations' own curves, each as
+/// the `curve` computation gives it for that seed; a store of another path is not reused.
+#[test]
+fn an_ensemble_with_curves_gives_per_point_statistics_of_the_realizations_curves() {
+    use fibercell::ensemble::CurvePath;
+    use fibercell::homogenize::{elasto_plastic_curve, CurveOptions};
+    use fibercell::solve::IncrementalOptions;
+    let params = small_nonwoven(50);
+    let path = CurvePath {
+        strain: [0.05, 0.0, 0.0, 0.0, 0.0, 0.0],
+        steps: 10,
+        unload: true,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let opts = EnsembleOptions {
+        curve: Some(path.clone()),
+        ..options(params.clone(), 3)
+    };
+    let e = run_ensemble(&opts, Some(dir.path()), None).unwrap();
+    assert!(e.failed().is_empty(), "{:?}", e.failed());
+    let stats = e.curve.as_ref().unwrap();
+    assert_eq!(
+        (stats.curves, stats.points.len(), stats.component),
+        (3, 30, 0)
+    );
+    // Each seed's curve computed directly.
+    let direct: Vec<Vec<[f64; 6]>> = (1..=3)
+        .map(|seed| {
+            let d = params.with_seed(seed).generate().unwrap();
+            let model = Model::from_description(&d).unwrap();
+            let c = elasto_plastic_curve(
+                &model,
+                &CurveOptions {
+                    strain: path.strain,
+                    steps: path.steps,
+                    unload: path.unload,
+                    incremental: IncrementalOptions::default(),
+                },
+            )
+            .unwrap();
+            c.points.iter().map(|p| p.resultant).collect()
+        })
+        .collect();
+    // Three values: ci95 = t₀.₉₇₅,₂ s/√3 with t = 4.303 (Abramowitz & Stegun table 26.10).
+    // Two runs of one curve agree to their equilibrium residuals (≤ 1e-8), not bitwise: the
+    // choice between a low-rank solve and a refactorization uses measured times.
+    for (k, p) in stats.points.iter().enumerate() {
+        assert_eq!(p.step, k + 1);
+        let alpha = [k + 1, 20 - k - 1, k + 1 - 20][k / 10] as f64 / 10.0;
+        assert!(
+            (p.strain[0] - 0.05 * alpha).abs() < 1e-15,
+            "{k}: {:?}",
+            p.strain
+        );
+        for m in 0..6 {
+            let v: Vec<f64> = direct.iter().map(|c| c[k][m]).collect();
+            let scale = direct
+                .iter()
+                .flatten()
+                .map(|r| r[m].abs())
+                .fold(0.0, f64::max);
+            let mean = v.iter().sum::<f64>() / 3.0;
+            let s = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+            let x = &p.resultant[m];
+            assert_eq!(x.n, 3);
+            assert!(
+                (x.mean - mean).abs() <= 1e-7 * scale,
+                "{k} {m}: {} vs {mean}",
+                x.mean
+            );
+            assert!(
+                (x.std - s).abs() <= 1e-7 * scale,
+                "{k} {m}: {} vs {s}",
+                x.std
+            );
+            assert!((x.ci95 - 4.303 * x.std / 3f64.sqrt()).abs() <= 1e-4 * x.ci95.max(1e-300));
+        }
+    }
+    // Sliding happened (this cell's bonds hold to ε11 ≈ 1 %): the mean's secant at the peak
+    // is below the elastic slope A11, and the dissipation only grows.
+    let peak = stats.points[9].resultant[0].mean;
+    assert!(peak < 0.9 * e.abd[0][0].mean * 0.05, "{peak}");
+    let dissipated: Vec<f64> = stats.points.iter().map(|p| p.dissipated.mean).collect();
+    assert!(dissipated[9] > 0.0 && dissipated.windows(2).all(|w| w[1] >= w[0]));
+    assert_eq!(stats.convergence.len(), 2);
+    // The files: one row per point, one per realization and point, and the plot.
+    let files = tempfile::tempdir().unwrap();
+    fibercell::io::write_ensemble_files(files.path(), &e, "small").unwrap();
+    let read = |name: &str| std::fs::read_to_string(files.path().join(name)).unwrap();
+    let points = read("ensemble-curve.csv");
+    assert_eq!(points.lines().count(), 31);
+    assert!(points.starts_with("step,e11,e22,g12,k11,k22,k12,N11_mean,N11_std,N11_ci95,"));
+    let curves = read("curves.csv");
+    assert_eq!(curves.lines().count(), 91);
+    let row: Vec<f64> = curves
+        .lines()
+        .nth(61)
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!((row[0], row[1]), (3.0, 1.0));
+    let stored = e.realizations[2].curve.as_ref().unwrap()[0];
+    assert_eq!((row[2], row[8]), (stored.strain[0], stored.resultant[0]));
+    assert!(read("ensemble-curve.svg").contains("95 % interval of the mean"));
+    // A rerun reuses the curves; a store of another path is refused.
+    let again = run_ensemble(&opts, Some(dir.path()), None).unwrap();
+    assert_eq!((again.reused, &again.curve), (3, &e.curve));
+    let other = EnsembleOptions {
+        curve: Some(CurvePath {
+            steps: 20,
+            ..path.clone()
+        }),
+        ..options(params, 3)
+    };
+    let err = run_ensemble(&other, Some(dir.path()), None).unwrap_err();
+    assert!(err.to_string().contains("another curve path"), "{err}");
 }

@@ -1,7 +1,9 @@
 //! The ensemble run: realizations of consecutive seeds, each stored as it finishes, then the
-//! statistics of every ABD entry and the convergence of the confidence interval.
+//! statistics of every ABD entry (and curve point) and the convergence of the confidence
+//! interval.
 
-use super::realization::{run_realization, Realization, RealizationStore};
+use super::curve_statistics::CurveStatistics;
+use super::realization::{run_realization, CurvePath, Realization, RealizationStore};
 use super::statistics::{summarize, SampleSummary};
 use crate::generate::CellParams;
 use crate::solve::SolveOptions;
@@ -21,8 +23,10 @@ pub struct EnsembleOptions {
     pub realizations: usize,
     /// Seed of the first realization; the others follow it.
     pub first_seed: u64,
-    /// Linear solver of the cell problems.
+    /// Linear solver of the cell problems (and curves).
     pub solve: SolveOptions,
+    /// Also ramp each realization along this path (the `curve` command's).
+    pub curve: Option<CurvePath>,
 }
 
 /// The diagonal ABD entries whose interval convergence is reported: A11, A22, A66, D11, D22,
@@ -49,11 +53,17 @@ pub struct Ensemble {
     pub convergence: Vec<ConvergencePoint>,
     /// Realizations read back from an earlier run instead of computed.
     pub reused: usize,
+    /// Statistics of the curves, when the ensemble has them.
+    pub curve: Option<CurveStatistics>,
 }
 
 impl Ensemble {
-    /// The statistics of `realizations` (in seed order).
-    pub fn from_realizations(realizations: Vec<Realization>, reused: usize) -> Self {
+    /// The statistics of `realizations` (in seed order), with their curves' along `path`.
+    pub fn from_realizations(
+        realizations: Vec<Realization>,
+        reused: usize,
+        path: Option<&CurvePath>,
+    ) -> Self {
         let ok: Vec<&[[f64; 6]; 6]> = realizations.iter().filter_map(|r| r.abd.as_ref()).collect();
         let abd = std::array::from_fn(|i| {
             std::array::from_fn(|j| summarize(&ok.iter().map(|a| a[i][j]).collect::<Vec<_>>()))
@@ -66,11 +76,13 @@ impl Ensemble {
                 }),
             })
             .collect();
+        let curve = path.map(|p| CurveStatistics::from_realizations(p, &realizations));
         Ensemble {
             realizations,
             abd,
             convergence,
             reused,
+            curve,
         }
     }
 
@@ -83,7 +95,8 @@ impl Ensemble {
     }
 }
 
-/// Runs the realizations of `opts` in seed order. With `store`, each is written to
+/// Runs the realizations of `opts` in seed order (each with its curve when `opts.curve` asks
+/// for one). With `store`, each is written to
 /// `store/realizations/seed-<seed>.json` as it finishes, and one already there is read back
 /// instead of run again (a killed run restarts where it stopped). `progress` hears of each
 /// realization as it is done (and whether it was reused).
@@ -107,7 +120,7 @@ pub fn run_ensemble(
             ))
         })?;
     let store = store
-        .map(|dir| RealizationStore::open(dir, &opts.params))
+        .map(|dir| RealizationStore::open(dir, &opts.params, opts.curve.as_ref()))
         .transpose()?;
     let mut done = Vec::with_capacity(opts.realizations);
     let mut reused = 0;
@@ -119,7 +132,7 @@ pub fn run_ensemble(
         let was_stored = earlier.is_some();
         let r = match earlier {
             Some(r) => r,
-            None => run_realization(&opts.params, seed, &opts.solve),
+            None => run_realization(&opts.params, seed, &opts.solve, opts.curve.as_ref()),
         };
         if let (Some(s), false) = (&store, was_stored) {
             s.save(&r)?;
@@ -130,5 +143,9 @@ pub fn run_ensemble(
         }
         done.push(r);
     }
-    Ok(Ensemble::from_realizations(done, reused))
+    Ok(Ensemble::from_realizations(
+        done,
+        reused,
+        opts.curve.as_ref(),
+    ))
 }

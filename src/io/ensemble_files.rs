@@ -1,7 +1,11 @@
 //! The result files of an ensemble: the statistics of every ABD entry (`ensemble.csv`), the
-//! convergence of the confidence interval (`convergence.csv` and a plot), and the whole run
-//! with every realization (`ensemble.json`, written last).
+//! convergence of the confidence interval (`convergence.csv` and a plot), the curves' files
+//! when it has curves (see [`super::ensemble_curve_files`]), and the whole run with every
+//! realization (`ensemble.json`, written last).
 
+use super::ensemble_curve_files::{
+    ensemble_curve_csv, ensemble_curve_plot, realization_curves_csv,
+};
 use super::plot::{LinePlot, Series};
 use crate::cell::MACRO_NAMES;
 use crate::ensemble::{Ensemble, MAIN_MODULI};
@@ -93,7 +97,8 @@ fn convergence_plot(e: &Ensemble, title: &str) -> Result<(String, Vec<u8>), Erro
     Ok((plot.svg()?, plot.png()?))
 }
 
-/// Writes `ensemble.csv`, `convergence.csv`, `convergence.svg`, `convergence.png` and last
+/// Writes `ensemble.csv`, `convergence.csv`, `convergence.svg`, `convergence.png`, with curves
+/// `ensemble-curve.csv`, `curves.csv`, `ensemble-curve.svg` and `ensemble-curve.png`, and last
 /// `ensemble.json` into `dir`, each atomically, so that a folder with `ensemble.json` is
 /// complete; returns their paths.
 pub fn write_ensemble_files(dir: &Path, e: &Ensemble, title: &str) -> Result<Vec<PathBuf>, Error> {
@@ -103,16 +108,25 @@ pub fn write_ensemble_files(dir: &Path, e: &Ensemble, title: &str) -> Result<Vec
     })?;
     let (svg, png) = convergence_plot(e, title)?;
     let (table, convergence) = (ensemble_csv(e), convergence_csv(e));
-    super::write_results(
-        dir,
-        &[
-            ("ensemble.csv", table.as_bytes()),
-            ("convergence.csv", convergence.as_bytes()),
-            ("convergence.svg", svg.as_bytes()),
-            ("convergence.png", &png),
-            ("ensemble.json", json.as_bytes()),
-        ],
-    )
+    let mut files: Vec<(&str, &[u8])> = vec![
+        ("ensemble.csv", table.as_bytes()),
+        ("convergence.csv", convergence.as_bytes()),
+        ("convergence.svg", svg.as_bytes()),
+        ("convergence.png", &png),
+    ];
+    let curve_tables = e
+        .curve
+        .as_ref()
+        .map(|c| (ensemble_curve_csv(c), realization_curves_csv(e)));
+    let curve_plot = ensemble_curve_plot(e, title)?;
+    if let (Some((points, curves)), Some((svg, png))) = (&curve_tables, &curve_plot) {
+        files.push(("ensemble-curve.csv", points.as_bytes()));
+        files.push(("curves.csv", curves.as_bytes()));
+        files.push(("ensemble-curve.svg", svg.as_bytes()));
+        files.push(("ensemble-curve.png", png));
+    }
+    files.push(("ensemble.json", json.as_bytes()));
+    super::write_results(dir, &files)
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ mod abaqus_export;
 mod atomic;
 mod catalog;
 mod curve_files;
+mod ensemble_curve_files;
 mod ensemble_files;
 mod inp_number;
 mod job_system;
@@ -25,6 +26,7 @@ pub use curve_files::{
     curve_csv, curve_plot, dominant_component, switches_csv, write_curve_files, RESULTANT_NAMES,
     RESULTANT_UNITS, STRAIN_UNITS,
 };
+pub use ensemble_curve_files::{ensemble_curve_csv, ensemble_curve_plot, realization_curves_csv};
 pub use ensemble_files::{abd_entry_name, convergence_csv, ensemble_csv, write_ensemble_files};
 pub use inp_number::{inp_number, MAX_FIELD};
 pub use job_system::{job_system, JobSystem};

@@ -13,7 +13,7 @@ pub struct Series<'a> {
     pub points: &'a [(f64, f64)],
     /// RGB colour.
     pub colour: (u8, u8, u8),
-    /// Legend text.
+    /// Legend text (none when empty: e.g. the second of two lines that share one).
     pub label: &'a str,
 }
 
@@ -141,18 +141,18 @@ impl Drawing for LinePlot<'_> {
             .draw()?;
         for s in self.series {
             let colour = RGBColor(s.colour.0, s.colour.1, s.colour.2);
-            chart
-                .draw_series(LineSeries::new(
-                    s.points
-                        .iter()
-                        .copied()
-                        .filter(|p| p.0.is_finite() && p.1.is_finite()),
-                    colour.stroke_width(2),
-                ))?
-                .label(s.label)
-                .legend(move |(x, y)| {
+            let drawn = chart.draw_series(LineSeries::new(
+                s.points
+                    .iter()
+                    .copied()
+                    .filter(|p| p.0.is_finite() && p.1.is_finite()),
+                colour.stroke_width(2),
+            ))?;
+            if !s.label.is_empty() {
+                drawn.label(s.label).legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(2))
                 });
+            }
         }
         if !self.markers.is_empty() {
             let crimson = RGBColor(220, 20, 60);
