@@ -1,5 +1,5 @@
 //! The Python extension `fibercell._fibercell`: models, the generators, `homogenize`, `curve`,
-//! the stateful cell (`Cell`, `CellState`) and the sparse solver layer. Results cross as the JSON the CLI prints (the same serializer,
+//! `ensemble`, the stateful cell (`Cell`, `CellState`) and the sparse solver layer. Results cross as the JSON the CLI prints (the same serializer,
 //! so the same digits); the Python package (`python/fibercell/__init__.py`) turns them into
 //! dictionaries with NumPy arrays. Every call that computes releases the GIL; every error is a
 //! `fibercell.FibercellError` (a `ValueError`) with the library's message, the text the CLI
@@ -202,6 +202,51 @@ fn curve_json(
     to_json(&c)
 }
 
+/// `ensemble`: N realizations of the generator of `params` (JSON tagged by `family`, as for
+/// `generate_json`) from seed `first_seed`, their ABD and, with `strain`, their curves, with
+/// the statistics, as the JSON `fibercell ensemble --json` prints. With `directory` each
+/// realization is stored there as it finishes and a rerun reuses them.
+#[pyfunction]
+#[pyo3(signature = (params, realizations, first_seed = 1, strain = None, steps = 100,
+                    unload = false, directory = None, solver = "faer-cholesky",
+                    ordering = "auto"))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments
+fn ensemble_json(
+    py: Python<'_>,
+    params: &str,
+    realizations: usize,
+    first_seed: u64,
+    strain: Option<&str>,
+    steps: usize,
+    unload: bool,
+    directory: Option<PathBuf>,
+    solver: &str,
+    ordering: &str,
+) -> PyResult<String> {
+    use fibercell::ensemble::{run_ensemble, CurvePath, EnsembleOptions};
+    let curve = strain
+        .map(|s| {
+            fibercell::cell::parse_macro_strain(s).map(|strain| CurvePath {
+                strain,
+                steps,
+                unload,
+            })
+        })
+        .transpose()
+        .map_err(error)?;
+    let opts = EnsembleOptions {
+        params: fibercell::generate::CellParams::from_json_with_defaults(params).map_err(error)?,
+        realizations,
+        first_seed,
+        solve: solve_options(solver, ordering)?,
+        curve,
+    };
+    let e = py
+        .detach(|| run_ensemble(&opts, directory.as_deref(), None))
+        .map_err(error)?;
+    to_json(&e)
+}
+
 /// `check`: the property checks of a model, as the JSON `fibercell check --json` prints.
 #[pyfunction]
 #[pyo3(signature = (model, accuracy = None, penalty_study = true, max_penetration = 0.1,
@@ -326,6 +371,7 @@ fn _fibercell(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(generate_json, m)?)?;
     m.add_function(wrap_pyfunction!(homogenize_json, m)?)?;
     m.add_function(wrap_pyfunction!(curve_json, m)?)?;
+    m.add_function(wrap_pyfunction!(ensemble_json, m)?)?;
     m.add_function(wrap_pyfunction!(check_json, m)?)?;
     Ok(())
 }

@@ -250,3 +250,44 @@ def test_cell_trial_copy_threads_and_errors():
     with pytest.raises(fibercell.FibercellError, match="unknown strain"):
         cell.update(point, {"e33": 1e-3})
     assert point.updates == 2
+
+
+def test_ensemble_statistics_are_those_of_its_realizations(tmp_path):
+    import tomllib
+
+    import scipy.stats
+
+    params = tomllib.loads((ROOT / "fixtures/cells/nonwoven_small.params.toml").read_text())
+    family = params.pop("family")
+    params.pop("seed")
+    params["amount"] = {"kind": "count", "fibers": 50}
+    # This cell's bonds hold to e11 ≈ 1 %: at 5 % its contacts slide.
+    run = lambda: fibercell.ensemble(  # noqa: E731
+        family, 3, strain={"e11": 0.05}, steps=5, directory=tmp_path, **params
+    )
+    doc = run()
+    a = doc["arrays"]
+    assert a["abd"].shape == (3, 6, 6) and a["curves"].shape == (3, 5, 6)
+    # Each realization's ABD is its seed's cell's, to the last digit.
+    for k, seed in enumerate((1, 2, 3)):
+        cell = fibercell.generate(family, seed=seed, **params)
+        assert a["abd"][k].tolist() == fibercell.homogenize(cell)["abd"].tolist()
+    # Mean, sample deviation and the interval t(0.975, n − 1) s / √n, entry by entry.
+    t = scipy.stats.t.ppf(0.975, 2)
+    scale = np.abs(a["abd"]).max(axis=0)
+    assert np.all(np.abs(a["abd_mean"] - a["abd"].mean(axis=0)) <= 1e-13 * scale)
+    assert np.all(np.abs(a["abd_std"] - a["abd"].std(axis=0, ddof=1)) <= 1e-12 * scale)
+    assert np.allclose(a["abd_ci95"], t * a["abd_std"] / np.sqrt(3), rtol=1e-6)
+    curve_scale = np.abs(a["curves"]).max(axis=(0, 1))
+    assert np.all(np.abs(a["curve_mean"] - a["curves"].mean(axis=0)) <= 1e-13 * curve_scale)
+    assert np.all(
+        np.abs(a["curve_std"] - a["curves"].std(axis=0, ddof=1)) <= 1e-12 * curve_scale
+    )
+    assert np.allclose(a["curve_ci95"], t * a["curve_std"] / np.sqrt(3), rtol=1e-6)
+    assert a["curve_strain"][:, 0] == pytest.approx([0.01, 0.02, 0.03, 0.04, 0.05], rel=1e-14)
+    # Sliding: the mean's secant at 5 % is below the mean elastic slope A11.
+    assert a["curve_mean"][-1, 0] < 0.9 * 0.05 * a["abd_mean"][0, 0]
+    # A rerun on the same directory reuses every realization.
+    again = run()
+    assert again["reused"] == 3
+    assert np.array_equal(again["arrays"]["curves"], a["curves"])

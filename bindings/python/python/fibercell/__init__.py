@@ -2,7 +2,7 @@
 
 A thin layer over the Rust library (``fibercell._fibercell``): models from files, strings or
 dictionaries, the cell generators, the elastic homogenization (ABD), the friction-driven
-elasto-plastic curve, the stateful cell of a macro-scale code (:class:`Cell`) and the sparse
+elasto-plastic curve, stochastic ensembles, the stateful cell of a macro-scale code (:class:`Cell`) and the sparse
 solver layer. Results are the documents the CLI prints
 with ``--json`` (the same serializer, the same digits), with NumPy arrays for the matrices and
 the curve's columns. Errors raise :class:`FibercellError` (a ``ValueError``) with the
@@ -18,7 +18,9 @@ library's message; every computation releases the GIL.
 from __future__ import annotations
 
 import json
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+import math
+import os
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -34,6 +36,7 @@ __all__ = [
     "__version__",
     "check",
     "curve",
+    "ensemble",
     "generate",
     "homogenize",
     "model_from_dict",
@@ -141,6 +144,86 @@ def curve(
             [p["equilibrium_residual"] for p in points], dtype=float
         ),
     }
+    return doc
+
+
+def _summary_arrays(summaries: Any) -> Dict[str, np.ndarray]:
+    """``mean``, ``std`` and ``ci95`` arrays of nested SampleSummary documents (an infinite
+    interval, of one value, crosses JSON as null: NaN here)."""
+
+    def field(name: str) -> np.ndarray:
+        def pick(x: Any) -> Any:
+            if isinstance(x, list):
+                return [pick(y) for y in x]
+            v = x[name]
+            return math.inf if v is None and name == "ci95" else v
+
+        return np.array(pick(summaries), dtype=float)
+
+    return {name: field(name) for name in ("mean", "std", "ci95")}
+
+
+def ensemble(
+    family: str,
+    realizations: int,
+    first_seed: int = 1,
+    strain: Union[None, str, Mapping[str, float]] = None,
+    steps: int = 100,
+    unload: bool = False,
+    directory: Union[None, str, "os.PathLike[str]"] = None,
+    solver: str = "faer-cholesky",
+    ordering: str = "auto",
+    **params: Any,
+) -> dict:
+    """The scatter of a random cell from seed to seed: ``realizations`` cells of the generator
+    ``family`` with ``params`` (as for :func:`generate`; the seed is each realization's, from
+    ``first_seed`` on), the six cell problems of each and, with ``strain``, its curve (as for
+    :func:`curve`, with the generator's contact law). The document of ``fibercell ensemble
+    --json`` — every realization (its ABD, or ``error``), the statistics and the interval's
+    convergence —, plus ``arrays``: ``abd`` (N × 6 × 6, NaN for a failed realization) and
+    ``abd_mean``, ``abd_std``, ``abd_ci95`` (6 × 6, the 95 % interval of the mean); with
+    curves, ``curves`` (N × points × 6 resultants, NaN for a failed curve), ``curve_strain``
+    (points × 6) and ``curve_mean``, ``curve_std``, ``curve_ci95`` (points × 6). With
+    ``directory``, each realization is stored there as it finishes and a rerun reuses them."""
+    doc = json.loads(
+        _fibercell.ensemble_json(
+            json.dumps({"family": family, **params}),
+            realizations,
+            first_seed=first_seed,
+            strain=None if strain is None else _strain_text(strain),
+            steps=steps,
+            unload=unload,
+            directory=None if directory is None else os.fspath(directory),
+            solver=solver,
+            ordering=ordering,
+        )
+    )
+    nan6 = np.full((6, 6), np.nan)
+    arrays = {
+        "abd": np.array(
+            [nan6 if r["abd"] is None else r["abd"] for r in doc["realizations"]], dtype=float
+        ).reshape(-1, 6, 6),
+        **{f"abd_{k}": v for k, v in _summary_arrays(doc["abd"]).items()},
+    }
+    stats = doc.get("curve")
+    if stats is not None:
+        points = stats["points"]
+        n = len(points)
+        missing = np.full((n, 6), np.nan)
+
+        def resultants(r: Mapping[str, Any]) -> Any:
+            c = r.get("curve")
+            return missing if c is None or len(c) != n else [p["resultant"] for p in c]
+
+        arrays["curves"] = np.array(
+            [resultants(r) for r in doc["realizations"]], dtype=float
+        ).reshape(-1, n, 6)
+        arrays["curve_strain"] = np.array([p["strain"] for p in points], dtype=float).reshape(
+            -1, 6
+        )
+        for k, v in _summary_arrays([p["resultant"] for p in points]).items():
+            arrays[f"curve_{k}"] = v.reshape(-1, 6)
+    doc["arrays"] = arrays
     return doc
 
 

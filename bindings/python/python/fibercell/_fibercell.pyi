@@ -87,6 +87,17 @@ def check_json(
     solver: str = "faer-cholesky",
     ordering: str = "auto",
 ) -> str: ...
+def ensemble_json(
+    params: str,
+    realizations: int,
+    first_seed: int = 1,
+    strain: Optional[str] = None,
+    steps: int = 100,
+    unload: bool = False,
+    directory: Optional[Union[str, PathLike[str]]] = None,
+    solver: str = "faer-cholesky",
+    ordering: str = "auto",
+) -> str: ...
 def curve_json(
     model: Model,
     strain: str,
