@@ -196,6 +196,37 @@ enum Command {
         #[command(flatten)]
         out: OutDir,
     },
+    /// The representative volume of a non-woven: an ensemble at each cell size (fibers per
+    /// unit area kept), the main moduli's mean and scatter against size, and the size from
+    /// which their relative 95 % interval stays within the tolerance. Each size keeps its
+    /// realizations in DIR/size-<L>; a rerun reuses them.
+    RveStudy {
+        /// Non-woven preset (S, M or L) at its own size.
+        #[arg(long, conflicts_with = "params", required_unless_present = "params")]
+        preset: Option<String>,
+        /// Non-woven parameter file (`family = "nonwoven"`, as `fixtures/cells/*.params.toml`).
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Cell sides L in m, comma-separated and increasing (square cells L × L).
+        #[arg(long, value_delimiter = ',', required = true)]
+        sizes: Vec<f64>,
+        /// Realizations per size.
+        #[arg(short = 'n', long)]
+        realizations: usize,
+        /// Seed of the first realization of every size.
+        #[arg(long, default_value_t = 1)]
+        first_seed: u64,
+        /// Largest relative 95 % interval of a main modulus's mean at a representative size.
+        #[arg(long, default_value_t = 0.05)]
+        tolerance: f64,
+        #[command(flatten)]
+        solver: SolverArgs,
+        /// Print one JSON document instead of the table.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        out: OutDir,
+    },
     /// Statistics of a model: fibers, length, volume fraction, orientation tensor, contacts.
     Stats {
         /// Model file.
@@ -993,12 +1024,7 @@ fn ensemble(
         curve,
     };
     let mut report = |r: &fibercell::ensemble::Realization, reused: bool| {
-        let what = match (&r.error, reused) {
-            (Some(e), _) => format!("failed: {e}"),
-            (None, true) => "reused".into(),
-            (None, false) => format!("{:.2} s", r.seconds),
-        };
-        eprintln!("seed {}: {what}", r.seed);
+        eprintln!("seed {}: {}", r.seed, realization_outcome(r, reused));
     };
     // ensemble.json is written last: a folder that holds it is complete.
     io::begin_results(out, "ensemble.json")?;
@@ -1050,6 +1076,99 @@ fn ensemble(
     }
     for (seed, err) in &failed {
         println!("  seed {seed} failed: {err}");
+    }
+    Ok(())
+}
+
+/// How a realization ended, for the progress lines of `ensemble` and `rve-study`.
+fn realization_outcome(r: &fibercell::ensemble::Realization, reused: bool) -> String {
+    match (&r.error, reused) {
+        (Some(e), _) => format!("failed: {e}"),
+        (None, true) => "reused".into(),
+        (None, false) => format!("{:.2} s", r.seconds),
+    }
+}
+
+fn rve_study(
+    (preset, params): (Option<&str>, Option<&Path>),
+    mut opts: fibercell::ensemble::RveStudyOptions,
+    json: bool,
+    out: &Path,
+) -> Result<(), Error> {
+    use fibercell::ensemble::{run_rve_study, MAIN_MODULI};
+    use fibercell::generate::{nonwoven_preset, CellParams};
+    let (base, name) = match (preset, params) {
+        (Some(p), _) => (
+            nonwoven_preset(p, opts.first_seed)?,
+            format!("non-woven {p}"),
+        ),
+        (None, Some(path)) => match io::read_cell_params(path)? {
+            CellParams::Nonwoven(n) => (n, path.display().to_string()),
+            _ => {
+                return Err(Error::InvalidOption(format!(
+                    "{}: an RVE study needs a random cell (family = \"nonwoven\"); the woven, \
+                     knitted and geotextile generators give one cell per size",
+                    path.display()
+                )))
+            }
+        },
+        (None, None) => {
+            return Err(Error::InvalidOption(
+                "give the generator: --preset S|M|L or --params FILE".into(),
+            ))
+        }
+    };
+    opts.params = base;
+    let mut report = |size: f64, r: &fibercell::ensemble::Realization, reused: bool| {
+        let what = realization_outcome(r, reused);
+        eprintln!("L = {size:e} m, seed {}: {what}", r.seed);
+    };
+    // rve.json is written last: a folder that holds it is complete.
+    io::begin_results(out, "rve.json")?;
+    let study = run_rve_study(&opts, Some(out), Some(&mut report))?;
+    let title = format!(
+        "{name}: RVE study, {} realizations per size",
+        opts.realizations
+    );
+    io::write_rve_files(out, &study, &title)?;
+    if json {
+        println!("{}", to_pretty(&study)?);
+        return Ok(());
+    }
+    println!("{title}; results in {}", out.display());
+    for z in &study.sizes {
+        let row: Vec<String> = MAIN_MODULI
+            .iter()
+            .zip(&z.moduli)
+            .map(|(&k, x)| {
+                format!(
+                    "{} {:.4e} ± {:.1} %",
+                    io::abd_entry_name(k, k),
+                    x.mean,
+                    100.0 * x.relative_ci95()
+                )
+            })
+            .collect();
+        let failed = z.ensemble.failed();
+        let moduli = match failed.first() {
+            Some((seed, e)) if z.moduli[0].n == 0 => format!("all failed (seed {seed}: {e})"),
+            _ => row.join(", "),
+        };
+        println!(
+            "  L = {:.4e} m, {} of {} realizations: {moduli}",
+            z.size,
+            z.moduli[0].n,
+            z.ensemble.realizations.len(),
+        );
+    }
+    let size = |s: Option<f64>| s.map_or("beyond the sizes studied".into(), |l| format!("{l:e} m"));
+    println!(
+        "  representative (every main modulus within ± {:.1} %): {}",
+        100.0 * study.tolerance,
+        size(study.representative_all)
+    );
+    for (&k, r) in MAIN_MODULI.iter().zip(&study.representative) {
+        println!("    {}: {}", io::abd_entry_name(k, k), size(*r));
     }
     Ok(())
 }
@@ -1515,6 +1634,29 @@ fn main() -> ExitCode {
                 steps,
                 unload,
             }),
+            json,
+            &out.dir,
+        ),
+        Command::RveStudy {
+            preset,
+            params,
+            sizes,
+            realizations,
+            first_seed,
+            tolerance,
+            solver,
+            json,
+            out,
+        } => rve_study(
+            (preset.as_deref(), params.as_deref()),
+            fibercell::ensemble::RveStudyOptions {
+                params: fibercell::generate::NonWoven::default(),
+                sizes,
+                realizations,
+                first_seed,
+                tolerance,
+                solve: solver.options(),
+            },
             json,
             &out.dir,
         ),

@@ -251,3 +251,72 @@ fn an_ensemble_with_curves_gives_per_point_statistics_of_the_realizations_curves
     let err = run_ensemble(&other, Some(dir.path()), None).unwrap_err();
     assert!(err.to_string().contains("another curve path"), "{err}");
 }
+
+/// The RVE study: at each size the ensemble of the non-woven with its fibers per unit area
+/// kept, the representative size read off the intervals, a rerun that reuses every
+/// realization, and sizes a fiber cannot fit refused before anything runs.
+#[test]
+fn an_rve_study_is_an_ensemble_per_size_at_constant_density() {
+    use fibercell::ensemble::{run_rve_study, RveStudyOptions, MAIN_MODULI};
+    use fibercell::generate::NonWoven;
+    let CellParams::Nonwoven(base) = small_nonwoven(50) else {
+        unreachable!()
+    };
+    let study_opts = |tolerance: f64| RveStudyOptions {
+        params: base.clone(),
+        sizes: vec![0.005, 0.006],
+        realizations: 3,
+        first_seed: 1,
+        tolerance,
+        solve: SolveOptions::default(),
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let study = run_rve_study(&study_opts(0.05), Some(dir.path()), None).unwrap();
+    // 50 fibers on 5 × 5 mm², so 72 on 6 × 6 mm².
+    let fibers = |p: &NonWoven| match p.amount {
+        FiberAmount::Count { fibers } => fibers,
+        _ => unreachable!(),
+    };
+    assert_eq!(fibers(&study.sizes[0].params), 50);
+    assert_eq!(fibers(&study.sizes[1].params), 72);
+    assert_eq!(study.sizes[1].params.size, [0.006, 0.006]);
+    for z in &study.sizes {
+        let direct = run_ensemble(
+            &options(CellParams::Nonwoven(z.params.clone()), 3),
+            None,
+            None,
+        )
+        .unwrap();
+        assert_eq!(z.moduli, MAIN_MODULI.map(|k| direct.abd[k][k]));
+    }
+    // The representative size: the smallest from which every interval is within tolerance.
+    let worst = |z: usize| {
+        (0..6)
+            .map(|m| study.sizes[z].moduli[m].relative_ci95())
+            .fold(0.0, f64::max)
+    };
+    let loose = run_rve_study(
+        &study_opts(1.01 * worst(0).max(worst(1))),
+        Some(dir.path()),
+        None,
+    )
+    .unwrap();
+    assert_eq!(loose.representative_all, Some(0.005));
+    let between = 0.5 * (worst(0) + worst(1));
+    let expected = (worst(1) < worst(0)).then_some(0.006);
+    let mid = run_rve_study(&study_opts(between), Some(dir.path()), None).unwrap();
+    assert_eq!(mid.representative_all, expected);
+    assert_eq!(study.representative_all, None, "{:?}", study.representative);
+    // Reruns reuse every realization of every size.
+    assert!(mid.sizes.iter().all(|z| z.ensemble.reused == 3));
+    let mut small = study_opts(0.05);
+    small.sizes = vec![0.004, 0.006];
+    let err = run_rve_study(&small, None, None).unwrap_err().to_string();
+    assert!(
+        err.contains("cell size 0.004 m") && err.contains("half the smaller period"),
+        "{err}"
+    );
+    small.sizes = vec![0.006, 0.005];
+    let err = run_rve_study(&small, None, None).unwrap_err().to_string();
+    assert!(err.contains("increasing order"), "{err}");
+}

@@ -59,8 +59,14 @@ pub fn convergence_csv(e: &Ensemble) -> String {
     s
 }
 
-/// The relative interval of the main moduli against n (SVG, PNG).
-fn convergence_plot(e: &Ensemble, title: &str) -> Result<(String, Vec<u8>), Error> {
+/// One line per main modulus (A11, A22, A66, D11, D22, D66: `points[m]`), and `extra` lines
+/// after them (SVG, PNG).
+pub(super) fn main_moduli_plot(
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    points: &[Vec<(f64, f64)>],
+    extra: Option<Series>,
+) -> Result<(String, Vec<u8>), Error> {
     const COLOURS: [(u8, u8, u8); 6] = [
         (70, 130, 180),
         (220, 20, 60),
@@ -70,6 +76,30 @@ fn convergence_plot(e: &Ensemble, title: &str) -> Result<(String, Vec<u8>), Erro
         (105, 105, 105),
     ];
     let names: Vec<String> = MAIN_MODULI.iter().map(|&k| abd_entry_name(k, k)).collect();
+    let mut series: Vec<Series> = points
+        .iter()
+        .zip(COLOURS)
+        .zip(&names)
+        .map(|((points, colour), label)| Series {
+            points,
+            colour,
+            label,
+        })
+        .collect();
+    series.extend(extra);
+    let plot = LinePlot {
+        title,
+        x_label,
+        y_label,
+        series: &series,
+        markers: &[],
+        marker_label: "",
+    };
+    Ok((plot.svg()?, plot.png()?))
+}
+
+/// The relative interval of the main moduli against n (SVG, PNG).
+fn convergence_plot(e: &Ensemble, title: &str) -> Result<(String, Vec<u8>), Error> {
     let points: Vec<Vec<(f64, f64)>> = (0..MAIN_MODULI.len())
         .map(|m| {
             e.convergence
@@ -79,22 +109,8 @@ fn convergence_plot(e: &Ensemble, title: &str) -> Result<(String, Vec<u8>), Erro
                 .collect()
         })
         .collect();
-    let series: Vec<Series> = (0..MAIN_MODULI.len())
-        .map(|m| Series {
-            points: &points[m],
-            colour: COLOURS[m],
-            label: &names[m],
-        })
-        .collect();
-    let plot = LinePlot {
-        title,
-        x_label: "realizations n",
-        y_label: "95 % interval of the mean / mean (%)",
-        series: &series,
-        markers: &[],
-        marker_label: "",
-    };
-    Ok((plot.svg()?, plot.png()?))
+    let labels = ("realizations n", "95 % interval of the mean / mean (%)");
+    main_moduli_plot(title, labels, &points, None)
 }
 
 /// Writes `ensemble.csv`, `convergence.csv`, `convergence.svg`, `convergence.png`, with curves

@@ -15,6 +15,7 @@ mod matrix_market;
 mod native;
 mod plot;
 mod results;
+mod rve_files;
 mod vtk;
 
 pub use crate::input_error::InputError;
@@ -36,6 +37,7 @@ pub use plot::{LinePlot, RosePlot, Series, PLOT_SIZE, ROSE_SIZE};
 pub use results::{
     contacts_csv, displacements_csv, incremental_json, increments_csv, solution_json,
 };
+pub use rve_files::{rve_csv, write_rve_files};
 pub use vtk::{
     contacts_vtp, model_vtk, network_vtk, series_pvd, step_file, NetworkFormat, VtkEncoding,
 };
