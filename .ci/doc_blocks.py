@@ -32,6 +32,10 @@ COVERED = [
     (re.compile(r"\bmaturin develop\b"), "the Python package step of .ci/run"),
     (re.compile(r"-m pytest\b"), "the Python package step of .ci/run"),
     (re.compile(r"^cargo build --release -p fibercell-c$"), "the C ABI step of .ci/run"),
+    (re.compile(r"^cargo build --release --features mpi$"),
+     "the all-features tests of .ci/run (tests/ensemble_mpi.rs runs mpirun -np 2)"),
+    (re.compile(r"^mpirun\b"),
+     "the all-features tests of .ci/run (tests/ensemble_mpi.rs runs mpirun -np 2)"),
 ]
 
 

@@ -1002,7 +1002,7 @@ fn ensemble(
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
-    use fibercell::ensemble::{run_ensemble, EnsembleOptions, MAIN_MODULI};
+    use fibercell::ensemble::{EnsembleOptions, MAIN_MODULI};
     use fibercell::generate::{nonwoven_preset, CellParams};
     let (params, name) = match (preset, params) {
         (Some(p), _) => (
@@ -1026,9 +1026,9 @@ fn ensemble(
     let mut report = |r: &fibercell::ensemble::Realization, reused: bool| {
         eprintln!("seed {}: {}", r.seed, realization_outcome(r, reused));
     };
-    // ensemble.json is written last: a folder that holds it is complete.
-    io::begin_results(out, "ensemble.json")?;
-    let e = run_ensemble(&opts, Some(out), Some(&mut report))?;
+    let Some(e) = ensemble_on_ranks(&opts, out, &mut report)? else {
+        return Ok(()); // a rank of an MPI job other than 0: rank 0 reports
+    };
     let title = format!("{name}: {} realizations", e.realizations.len());
     io::write_ensemble_files(out, &e, &title)?;
     if json {
@@ -1078,6 +1078,47 @@ fn ensemble(
         println!("  seed {seed} failed: {err}");
     }
     Ok(())
+}
+
+/// Runs the ensemble — over the ranks of an MPI job when started by `mpirun` with more than
+/// one rank (feature `mpi`), else in this process — and returns it on the rank that reports
+/// (`None` on the others). `ensemble.json` is written last: a folder that holds it is complete.
+fn ensemble_on_ranks(
+    opts: &fibercell::ensemble::EnsembleOptions,
+    out: &Path,
+    report: fibercell::ensemble::EnsembleProgress<'_>,
+) -> Result<Option<fibercell::ensemble::Ensemble>, Error> {
+    #[cfg(feature = "mpi")]
+    {
+        use mpi::traits::Communicator;
+        let universe = mpi::initialize();
+        if let Some(world) = universe
+            .as_ref()
+            .map(|u| u.world())
+            .filter(|w| w.size() > 1)
+        {
+            let root = world.rank() == 0;
+            let began = if root {
+                io::begin_results(out, "ensemble.json")
+            } else {
+                Ok(())
+            };
+            let run = began.and_then(|()| {
+                let store = root.then_some(out);
+                fibercell::ensemble::run_ensemble_mpi(&world, opts, store, Some(report))
+            });
+            return match run {
+                Err(e) if root => {
+                    // The other ranks may wait for rank 0: end the whole job.
+                    eprintln!("error: {e}");
+                    world.abort(1)
+                }
+                other => other,
+            };
+        }
+    }
+    io::begin_results(out, "ensemble.json")?;
+    fibercell::ensemble::run_ensemble(opts, Some(out), Some(report)).map(Some)
 }
 
 /// How a realization ended, for the progress lines of `ensemble` and `rve-study`.

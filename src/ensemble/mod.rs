@@ -6,12 +6,16 @@
 //! realization is stored as it finishes, so a killed run restarts without losing finished work.
 
 mod curve_statistics;
+#[cfg(feature = "mpi")]
+mod mpi_run;
 mod realization;
 mod run;
 mod rve_study;
 mod statistics;
 
 pub use curve_statistics::{CurveConvergencePoint, CurvePointSummary, CurveStatistics};
+#[cfg(feature = "mpi")]
+pub use mpi_run::run_ensemble_mpi;
 pub use realization::{run_realization, CurvePath, CurveSample, Realization, RealizationStore};
 pub use run::{
     run_ensemble, ConvergencePoint, Ensemble, EnsembleOptions, EnsembleProgress, MAIN_MODULI,

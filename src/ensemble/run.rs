@@ -95,16 +95,8 @@ impl Ensemble {
     }
 }
 
-/// Runs the realizations of `opts` in seed order (each with its curve when `opts.curve` asks
-/// for one). With `store`, each is written to
-/// `store/realizations/seed-<seed>.json` as it finishes, and one already there is read back
-/// instead of run again (a killed run restarts where it stopped). `progress` hears of each
-/// realization as it is done (and whether it was reused).
-pub fn run_ensemble(
-    opts: &EnsembleOptions,
-    store: Option<&Path>,
-    mut progress: Option<EnsembleProgress<'_>>,
-) -> Result<Ensemble, Error> {
+/// The seeds of `opts`' realizations.
+pub(super) fn seeds(opts: &EnsembleOptions) -> Result<std::ops::RangeInclusive<u64>, Error> {
     if opts.realizations == 0 {
         return Err(Error::InvalidOption(
             "an ensemble needs at least one realization".into(),
@@ -119,12 +111,26 @@ pub fn run_ensemble(
                 opts.first_seed, opts.realizations
             ))
         })?;
+    Ok(opts.first_seed..=last)
+}
+
+/// Runs the realizations of `opts` in seed order (each with its curve when `opts.curve` asks
+/// for one). With `store`, each is written to
+/// `store/realizations/seed-<seed>.json` as it finishes, and one already there is read back
+/// instead of run again (a killed run restarts where it stopped). `progress` hears of each
+/// realization as it is done (and whether it was reused).
+pub fn run_ensemble(
+    opts: &EnsembleOptions,
+    store: Option<&Path>,
+    mut progress: Option<EnsembleProgress<'_>>,
+) -> Result<Ensemble, Error> {
+    let seeds = seeds(opts)?;
     let store = store
         .map(|dir| RealizationStore::open(dir, &opts.params, opts.curve.as_ref()))
         .transpose()?;
     let mut done = Vec::with_capacity(opts.realizations);
     let mut reused = 0;
-    for seed in opts.first_seed..=last {
+    for seed in seeds {
         let earlier = match &store {
             Some(s) => s.load(seed)?,
             None => None,
