@@ -37,10 +37,13 @@ pub fn run_ensemble_mpi<C: Communicator>(
         root.broadcast_into(&mut todo[..]);
         for seed in own_share(&todo, world) {
             let r = run_realization(&opts.params, seed, &opts.solve, opts.curve.as_ref());
-            let bytes = serde_json::to_vec(&r).map_err(|e| Error::Output {
-                path: format!("realization of seed {seed}"),
-                message: e.to_string(),
-            })?;
+            // Rank 0 waits for every realization: one that cannot be sent ends the job
+            // rather than leave it waiting (serde_json fails only on maps without string keys,
+            // which a realization has none of).
+            let Ok(bytes) = serde_json::to_vec(&r) else {
+                eprintln!("error: the realization of seed {seed} cannot be serialized");
+                world.abort(1)
+            };
             root.send_with_tag(&bytes[..], REALIZATION);
         }
         return Ok(None);
@@ -61,13 +64,14 @@ pub fn run_ensemble_mpi<C: Communicator>(
     let (seeds, store, stored) = match set_up {
         Ok(s) => s,
         Err(e) => {
-            root.broadcast_into(&mut FAILED.clone());
+            let mut failed = FAILED;
+            root.broadcast_into(&mut failed);
             return Err(e);
         }
     };
-    let todo: Vec<u64> = seeds.clone().filter(|s| !stored.contains_key(s)).collect();
+    let mut todo: Vec<u64> = seeds.clone().filter(|s| !stored.contains_key(s)).collect();
     root.broadcast_into(&mut (todo.len() as u64));
-    root.broadcast_into(&mut todo.clone()[..]);
+    root.broadcast_into(&mut todo[..]);
     let mut root_work = RootWork {
         store: store.as_ref(),
         progress,
