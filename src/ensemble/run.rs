@@ -95,7 +95,8 @@ impl Ensemble {
     }
 }
 
-/// The seeds of `opts`' realizations.
+/// The seeds of `opts`' realizations, after checking what every realization would refuse
+/// alike (no realization, a curve path without increments or with a non-finite strain).
 pub(super) fn seeds(opts: &EnsembleOptions) -> Result<std::ops::RangeInclusive<u64>, Error> {
     if opts.realizations == 0 {
         return Err(Error::InvalidOption(
@@ -111,6 +112,15 @@ pub(super) fn seeds(opts: &EnsembleOptions) -> Result<std::ops::RangeInclusive<u
                 opts.first_seed, opts.realizations
             ))
         })?;
+    if let Some(path) = &opts.curve {
+        if path.steps == 0 || path.strain.iter().any(|e| !e.is_finite()) {
+            return Err(Error::InvalidOption(format!(
+                "the curves' path: {} increments to strain {:?}; give at least one increment \
+                 and a finite strain",
+                path.steps, path.strain
+            )));
+        }
+    }
     Ok(opts.first_seed..=last)
 }
 

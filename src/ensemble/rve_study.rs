@@ -95,6 +95,8 @@ pub fn run_rve_study(
     mut progress: Option<RveProgress<'_>>,
 ) -> Result<RveStudy, Error> {
     check_sizes(&opts.sizes)?;
+    // The base parameters set the density: a zero area or fiber count would scale to nonsense.
+    opts.params.validate()?;
     if !(opts.tolerance > 0.0 && opts.tolerance.is_finite()) {
         return Err(Error::InvalidOption(format!(
             "tolerance {}: give a positive relative interval, e.g. 0.05",
