@@ -3,6 +3,7 @@
 //! corrected with the residual of the assembled matrix.
 
 use super::assemble::System;
+use super::factors::ReferenceSolve;
 use super::increment::Increment;
 use super::matrix_values::MatrixValues;
 use super::options::{LOW_RANK_MATCH, MAX_REFINEMENTS, REUSE_ACCURACY};
@@ -252,8 +253,7 @@ impl StickSlip<'_, '_, '_> {
                 ))
             }
             first => {
-                let check =
-                    residual_check(setup, factors.reference_backward_error, matrix, system)?;
+                let check = residual_check(setup, factors.reference_solve, matrix, system)?;
                 refine_low_rank(&factors.low_rank, a0.as_mut(), &cap, &check, first)
                     .map_err(locate)?
                     .map(|r| (r, None))
@@ -288,7 +288,7 @@ impl StickSlip<'_, '_, '_> {
             .reference
             .as_mut()
             .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "factorize")))?;
-        let check = residual_check(setup, factors.reference_backward_error, matrix, system)?;
+        let check = residual_check(setup, factors.reference_solve, matrix, system)?;
         let checked = refine_low_rank(&factors.low_rank, a0.as_mut(), cap, &check, Ok(x))
             .map_err(|e| setup.locate(e))?;
         inc.lap(|t| &mut t.factor_reuse);
@@ -299,7 +299,7 @@ impl StickSlip<'_, '_, '_> {
         // Short of the reference's accuracy: the correction has drifted from a reference of
         // an earlier increment, and the same states are solved again on a new one; a reference
         // of this increment that cannot be matched is as good as its matrix allows.
-        if r.short_of_target && factors.reference_step != Some(inc.step) {
+        if r.short_of_target && factors.reference_solve.map(|r| r.step) != Some(inc.step) {
             factors.refresh_reference = true;
             return Ok(None);
         }
@@ -317,7 +317,7 @@ impl StickSlip<'_, '_, '_> {
 /// brought up to date first) and load, and the accuracy of a direct solve.
 fn residual_check<'s>(
     setup: &'s Setup<'_>,
-    reference_backward_error: Option<f64>,
+    reference: Option<ReferenceSolve>,
     matrix: &'s mut MatrixValues,
     system: &'s mut System,
 ) -> Result<ResidualCheck<'s>, Error> {
@@ -327,15 +327,13 @@ fn residual_check<'s>(
         &setup.pairs,
         system.changes.as_deref(),
     );
+    let direct = backward_tolerance(&setup.opts.solve);
     Ok(ResidualCheck {
         a: setup.pattern.matrix(&matrix.values)?,
         symmetric: !system.nonsymmetric,
         b: &system.rhs,
-        target: low_rank_target(
-            backward_tolerance(&setup.opts.solve),
-            reference_backward_error,
-        ),
-        tolerance: REUSE_ACCURACY * backward_tolerance(&setup.opts.solve),
+        target: low_rank_target(direct, reference.map(|r| r.backward_error)),
+        tolerance: REUSE_ACCURACY * direct,
     })
 }
 

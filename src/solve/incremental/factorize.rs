@@ -5,7 +5,7 @@
 use super::assemble::System;
 use super::contact_states::ContactStates;
 use super::driver_couplings::DriverCouplings;
-use super::factors::ReferenceBlock;
+use super::factors::{ReferenceBlock, ReferenceSolve};
 use super::increment::Increment;
 use super::StickSlip;
 use crate::contact::Friction;
@@ -141,8 +141,10 @@ impl StickSlip<'_, '_, '_> {
         if refactorized {
             // The reference's own load: A₀⁻¹ b₀ of this increment.
             factors.reference_solution = Some(Reference::Full(x.clone()));
-            factors.reference_backward_error = Some(r.backward_error);
-            factors.reference_step = Some(inc.step);
+            factors.reference_solve = Some(ReferenceSolve {
+                step: inc.step,
+                backward_error: r.backward_error,
+            });
         }
         Ok((x, Some(r)))
     }

@@ -91,11 +91,18 @@ pub(super) struct Factors {
     pub low_rank: LowRankCorrection,
     /// The references of earlier increments' b₀ on it, when b₀ is affine in α.
     pub affine: AffineReferences,
-    /// The backward error of the reference's own direct solve: what a low-rank solve on it
-    /// must come close to (see [`super::options::LOW_RANK_MATCH`]).
-    pub reference_backward_error: Option<f64>,
-    /// The increment whose solve factorized the reference.
-    pub reference_step: Option<usize>,
+    /// The reference's own direct solve, once factorized.
+    pub reference_solve: Option<ReferenceSolve>,
+}
+
+/// The direct solve that factorized the reference.
+#[derive(Clone, Copy, Debug)]
+pub struct ReferenceSolve {
+    /// The increment it belongs to.
+    pub step: usize,
+    /// Its backward error: what a low-rank solve on the reference must come close to (see
+    /// [`super::options::LOW_RANK_MATCH`]).
+    pub backward_error: f64,
 }
 
 impl Factors {
@@ -112,8 +119,7 @@ impl Factors {
             reference_solution: None,
             low_rank: LowRankCorrection::new(n_free, contacts),
             affine: AffineReferences::default(),
-            reference_backward_error: None,
-            reference_step: None,
+            reference_solve: None,
         }
     }
 
