@@ -46,6 +46,40 @@ impl SolverArgs {
     }
 }
 
+/// The random cells of `ensemble` and `rve-study`: a generator and the seeds of its realizations.
+#[derive(clap::Args, Clone, Debug)]
+struct GeneratorArgs {
+    /// Non-woven preset (S, M or L) as the generator.
+    #[arg(long, conflicts_with = "params", required_unless_present = "params")]
+    preset: Option<String>,
+    /// Generator parameter file (`family = "nonwoven"` etc., as `fixtures/cells/*.params.toml`).
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Number of realizations N (per cell size in `rve-study`).
+    #[arg(short = 'n', long)]
+    realizations: usize,
+    /// Seed of the first realization; the others follow it (at every size in `rve-study`).
+    #[arg(long, default_value_t = 1)]
+    first_seed: u64,
+}
+
+impl GeneratorArgs {
+    /// The generator's parameters (a preset's for the first seed) and its name for titles.
+    fn cell_params(&self) -> Result<(fibercell::generate::CellParams, String), Error> {
+        use fibercell::generate::{nonwoven_preset, CellParams};
+        match (&self.preset, &self.params) {
+            (Some(p), _) => Ok((
+                CellParams::Nonwoven(nonwoven_preset(p, self.first_seed)?),
+                format!("non-woven {p}"),
+            )),
+            (None, Some(path)) => Ok((io::read_cell_params(path)?, path.display().to_string())),
+            (None, None) => Err(Error::InvalidOption(
+                "give the generator: --preset S|M|L or --params FILE".into(),
+            )),
+        }
+    }
+}
+
 /// `-d DIR`: the directory of a command's result files (`-o` still accepted).
 #[derive(Args, Clone)]
 struct OutDir {
@@ -166,18 +200,8 @@ enum Command {
     /// Each realization is stored in DIR/realizations as it finishes; a rerun with the same DIR
     /// reuses them (a killed run loses no finished work).
     Ensemble {
-        /// Non-woven preset (S, M or L) as the generator.
-        #[arg(long, conflicts_with = "params", required_unless_present = "params")]
-        preset: Option<String>,
-        /// Generator parameter file (`family = "nonwoven"` etc., as `fixtures/cells/*.params.toml`).
-        #[arg(long)]
-        params: Option<PathBuf>,
-        /// Number of realizations N.
-        #[arg(short = 'n', long)]
-        realizations: usize,
-        /// Seed of the first realization; the others follow it.
-        #[arg(long, default_value_t = 1)]
-        first_seed: u64,
+        #[command(flatten)]
+        generator: GeneratorArgs,
         /// Also the elasto-plastic curve of each realization to this macroscopic strain (as
         /// `curve --strain`), with per point the mean and 95 % interval of the resultants.
         #[arg(long, value_parser = parse_strain)]
@@ -201,21 +225,11 @@ enum Command {
     /// which their relative 95 % interval stays within the tolerance. Each size keeps its
     /// realizations in DIR/size-<L>; a rerun reuses them.
     RveStudy {
-        /// Non-woven preset (S, M or L) at its own size.
-        #[arg(long, conflicts_with = "params", required_unless_present = "params")]
-        preset: Option<String>,
-        /// Non-woven parameter file (`family = "nonwoven"`, as `fixtures/cells/*.params.toml`).
-        #[arg(long)]
-        params: Option<PathBuf>,
+        #[command(flatten)]
+        generator: GeneratorArgs,
         /// Cell sides L in m, comma-separated and increasing (square cells L × L).
         #[arg(long, value_delimiter = ',', required = true)]
         sizes: Vec<f64>,
-        /// Realizations per size.
-        #[arg(short = 'n', long)]
-        realizations: usize,
-        /// Seed of the first realization of every size.
-        #[arg(long, default_value_t = 1)]
-        first_seed: u64,
         /// Largest relative 95 % interval of a main modulus's mean at a representative size.
         #[arg(long, default_value_t = 0.05)]
         tolerance: f64,
@@ -996,26 +1010,19 @@ fn curve(
 }
 
 fn ensemble(
-    (preset, params): (Option<&str>, Option<&Path>),
-    (realizations, first_seed, solve): (usize, u64, SolveOptions),
+    generator: &GeneratorArgs,
+    solve: SolveOptions,
     curve: Option<fibercell::ensemble::CurvePath>,
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
     use fibercell::ensemble::{EnsembleOptions, MAIN_MODULI};
-    use fibercell::generate::{nonwoven_preset, CellParams};
-    let (params, name) = match (preset, params) {
-        (Some(p), _) => (
-            CellParams::Nonwoven(nonwoven_preset(p, first_seed)?),
-            format!("non-woven {p}"),
-        ),
-        (None, Some(path)) => (io::read_cell_params(path)?, path.display().to_string()),
-        (None, None) => {
-            return Err(Error::InvalidOption(
-                "give the generator: --preset S|M|L or --params FILE".into(),
-            ))
-        }
-    };
+    let (params, name) = generator.cell_params()?;
+    let GeneratorArgs {
+        realizations,
+        first_seed,
+        ..
+    } = *generator;
     let opts = EnsembleOptions {
         params,
         realizations,
@@ -1131,33 +1138,19 @@ fn realization_outcome(r: &fibercell::ensemble::Realization, reused: bool) -> St
 }
 
 fn rve_study(
-    (preset, params): (Option<&str>, Option<&Path>),
+    generator: &GeneratorArgs,
     mut opts: fibercell::ensemble::RveStudyOptions,
     json: bool,
     out: &Path,
 ) -> Result<(), Error> {
     use fibercell::ensemble::{run_rve_study, MAIN_MODULI};
-    use fibercell::generate::{nonwoven_preset, CellParams};
-    let (base, name) = match (preset, params) {
-        (Some(p), _) => (
-            nonwoven_preset(p, opts.first_seed)?,
-            format!("non-woven {p}"),
-        ),
-        (None, Some(path)) => match io::read_cell_params(path)? {
-            CellParams::Nonwoven(n) => (n, path.display().to_string()),
-            _ => {
-                return Err(Error::InvalidOption(format!(
-                    "{}: an RVE study needs a random cell (family = \"nonwoven\"); the woven, \
-                     knitted and geotextile generators give one cell per size",
-                    path.display()
-                )))
-            }
-        },
-        (None, None) => {
-            return Err(Error::InvalidOption(
-                "give the generator: --preset S|M|L or --params FILE".into(),
-            ))
-        }
+    use fibercell::generate::CellParams;
+    let (params, name) = generator.cell_params()?;
+    let CellParams::Nonwoven(base) = params else {
+        return Err(Error::InvalidOption(format!(
+            "{name}: an RVE study needs a random cell (family = \"nonwoven\"); the woven, \
+             knitted and geotextile generators give one cell per size"
+        )));
     };
     opts.params = base;
     let mut report = |size: f64, r: &fibercell::ensemble::Realization, reused: bool| {
@@ -1657,10 +1650,7 @@ fn main() -> ExitCode {
         ),
         Command::Generate { kind } => generate(kind),
         Command::Ensemble {
-            preset,
-            params,
-            realizations,
-            first_seed,
+            generator,
             strain,
             steps,
             unload,
@@ -1668,8 +1658,8 @@ fn main() -> ExitCode {
             json,
             out,
         } => ensemble(
-            (preset.as_deref(), params.as_deref()),
-            (realizations, first_seed, solver.options()),
+            &generator,
+            solver.options(),
             strain.map(|strain| fibercell::ensemble::CurvePath {
                 strain,
                 steps,
@@ -1679,22 +1669,19 @@ fn main() -> ExitCode {
             &out.dir,
         ),
         Command::RveStudy {
-            preset,
-            params,
+            generator,
             sizes,
-            realizations,
-            first_seed,
             tolerance,
             solver,
             json,
             out,
         } => rve_study(
-            (preset.as_deref(), params.as_deref()),
+            &generator,
             fibercell::ensemble::RveStudyOptions {
                 params: fibercell::generate::NonWoven::default(),
                 sizes,
-                realizations,
-                first_seed,
+                realizations: generator.realizations,
+                first_seed: generator.first_seed,
                 tolerance,
                 solve: solver.options(),
             },
