@@ -36,6 +36,9 @@ COVERED = [
      "the all-features tests of .ci/run (tests/ensemble_mpi.rs runs mpirun -np 2)"),
     (re.compile(r"^mpirun\b"),
      "the all-features tests of .ci/run (tests/ensemble_mpi.rs runs mpirun -np 2)"),
+    # The same command as a test: a release build of its own would rebuild the library (2 min).
+    (re.compile(r"^cargo run --release --features cholmod -- solve fixtures/ok_frame3d\.toml --solver cholmod$"),
+     "the all-features tests of .ci/run (tests/cli.rs solves fixtures/ok_frame3d.toml with --solver cholmod)"),
 ]
 
 
