@@ -96,7 +96,8 @@ impl Ensemble {
 }
 
 /// The seeds of `opts`' realizations, after checking what every realization would refuse
-/// alike (no realization, a curve path without increments or with a non-finite strain).
+/// alike (no realization, a curve path without increments, with too many or a non-finite
+/// strain).
 pub(super) fn seeds(opts: &EnsembleOptions) -> Result<std::ops::RangeInclusive<u64>, Error> {
     if opts.realizations == 0 {
         return Err(Error::InvalidOption(
@@ -112,14 +113,8 @@ pub(super) fn seeds(opts: &EnsembleOptions) -> Result<std::ops::RangeInclusive<u
                 opts.first_seed, opts.realizations
             ))
         })?;
-    if let Some(path) = &opts.curve {
-        if path.steps == 0 || path.strain.iter().any(|e| !e.is_finite()) {
-            return Err(Error::InvalidOption(format!(
-                "the curves' path: {} increments to strain {:?}; give at least one increment \
-                 and a finite strain",
-                path.steps, path.strain
-            )));
-        }
+    if let Some(p) = &opts.curve {
+        crate::homogenize::check_curve_path(&p.strain, p.steps, p.unload)?;
     }
     Ok(opts.first_seed..=last)
 }

@@ -137,25 +137,26 @@ pub(super) fn check_small_strain(model: &Model, strain: &[f64; 6]) -> Result<(),
     Ok(())
 }
 
-/// Ramps the macroscopic strain of a periodic cell with contacts along `opts`.
-pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve, Error> {
-    if let Some(v) = opts.strain.iter().find(|v| !v.is_finite()) {
+/// The checks of a curve's path that need no model: a finite strain, at least one and at
+/// most [`crate::solve::MAX_INCREMENTS`] increments in all (an ensemble refuses such a path
+/// before its realizations run).
+pub fn check_curve_path(strain: &MacroStrain, steps: usize, unload: bool) -> Result<(), Error> {
+    if let Some(v) = strain.iter().find(|v| !v.is_finite()) {
         return Err(Error::InvalidOption(format!(
             "macroscopic strain component {v} is not finite"
         )));
     }
-    if opts.steps == 0 {
+    if steps == 0 {
         return Err(Error::InvalidOption(
             "the number of increments must be at least 1".into(),
         ));
     }
-    check_small_strain(model, &opts.strain)?;
-    let path_length = if opts.unload { 3 } else { 1 };
-    if opts.steps > crate::solve::MAX_INCREMENTS / path_length {
+    let path_length = if unload { 3 } else { 1 };
+    if steps > crate::solve::MAX_INCREMENTS / path_length {
         return Err(Error::InvalidOption(format!(
             "{} increments{}: at most {} in all (every increment's results are kept)",
-            opts.steps,
-            if opts.unload {
+            steps,
+            if unload {
                 " per branch of load, unload and reload"
             } else {
                 ""
@@ -163,6 +164,13 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
             crate::solve::MAX_INCREMENTS
         )));
     }
+    Ok(())
+}
+
+/// Ramps the macroscopic strain of a periodic cell with contacts along `opts`.
+pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve, Error> {
+    check_curve_path(&opts.strain, opts.steps, opts.unload)?;
+    check_small_strain(model, &opts.strain)?;
     // The cell is set up once: pairing, contacts, percolation through the closed contacts (the
     // all-stick system must hold together) and the anchor.
     let (p, set, anchor) = crate::homogenize::system::prepare_cell(model, true)?;

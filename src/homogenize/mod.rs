@@ -13,7 +13,8 @@ mod stick_system;
 pub(crate) mod system;
 
 pub use curve::{
-    elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEvent, MAX_MACRO_STRAIN,
+    check_curve_path, elasto_plastic_curve, Curve, CurveOptions, CurvePoint, SwitchEvent,
+    MAX_MACRO_STRAIN,
 };
 pub(crate) use elastic::{abd_asymmetry, abd_of, cell_rhs};
 pub use elastic::{
