@@ -20,7 +20,6 @@
 //! Units are SI throughout (m, N, Pa, rad). DOFs per node: ux, uy, uz, rx, ry, rz.
 
 pub mod assembly;
-pub mod bench;
 pub mod cell;
 pub mod check;
 pub mod constraints;

@@ -2,8 +2,7 @@
 //! `--steps 18446744073709551615` panicked with "capacity overflow", `--steps 100000000`
 //! aborted on a 33 GB allocation and `--steps 10000000` grew without bound; a contact
 //! `segment = 18446744073709551615` panicked on `segment + 1` (and wrapped to another fiber's
-//! element in a release build); `--length-cv nan` on the CLI was taken for a fixed length
-//! where the parameter file refuses it.
+//! element in a release build). The CLI's absurd options: `cli/tests/absurd_input.rs`.
 
 use fibercell::homogenize::{elasto_plastic_curve, CurveOptions};
 use fibercell::io::load_model;
@@ -11,7 +10,6 @@ use fibercell::solve::{
     solve_incremental, IncrementalOptions, MAX_CONTACT_RECORDS, MAX_INCREMENTS,
 };
 use std::path::Path;
-use std::process::Command;
 
 fn curve_error(steps: usize, unload: bool) -> String {
     let model = load_model(Path::new("fixtures/cells/nonwoven_small.toml")).expect("fixture");
@@ -57,81 +55,6 @@ fn runs_whose_records_would_not_fit_are_refused() {
     let e = curve_error(MAX_INCREMENTS, false);
     assert!(e.contains("contact records"), "{e}");
     assert!(e.contains(&MAX_CONTACT_RECORDS.to_string()), "{e}");
-}
-
-#[test]
-fn a_nan_length_cv_on_the_command_line_is_refused_like_in_the_file() {
-    let dir = std::env::temp_dir().join(format!("fibercell-absurd-{}", std::process::id()));
-    let out = Command::new(env!("CARGO_BIN_EXE_fibercell"))
-        .args([
-            "generate",
-            "nonwoven",
-            "--preset",
-            "S",
-            "--length-cv",
-            "nan",
-            "-o",
-        ])
-        .arg(dir.join("S.toml"))
-        .output()
-        .expect("runs");
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("length cv = NaN"), "{err}");
-    assert!(!dir.join("S.toml").exists());
-}
-
-/// Integer parameters whose arithmetic wrapped around are refused by name: a twill of
-/// 2⁶⁴−1 over 1 passed `over + under ≤ 64` (wrapped to 0) and gave "the model is empty";
-/// 2³² × 2³² knitted loops wrapped past the 10,000-loop bound and asked for 3.3 TB; a
-/// geotextile layer of 2⁶⁴−1 panicked (index out of bounds) after `layer + 1` wrapped to 0.
-#[test]
-fn wrapping_integer_parameters_are_refused() {
-    let max = usize::MAX.to_string();
-    let twill = format!("twill:{max}/1");
-    let wales = (1u64 << 32).to_string();
-    let family = format!("0,0.001,1e-5,{max}");
-    for (args, needle) in [
-        (
-            vec!["generate", "woven", "--pattern", &twill, "-o", "x.toml"],
-            "pattern over",
-        ),
-        (
-            vec![
-                "generate",
-                "knitted",
-                "--wales",
-                &wales,
-                "--courses",
-                &wales,
-                "-o",
-                "x.toml",
-            ],
-            "at most 10,000 loops",
-        ),
-        (
-            vec![
-                "generate",
-                "geotextile",
-                "--family",
-                &family,
-                "-o",
-                "x.toml",
-            ],
-            "families[0].layer",
-        ),
-    ] {
-        let o = Command::new(env!("CARGO_BIN_EXE_fibercell"))
-            .args(&args)
-            .output()
-            .expect("runs");
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
-        assert!(
-            err.contains(needle) && !err.contains("panicked"),
-            "{args:?}: {err}"
-        );
-    }
 }
 
 /// Arrays of the wrong length or with junk items are refused, naming the place: TOML's reader

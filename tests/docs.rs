@@ -144,10 +144,21 @@ fn the_architecture_page_lists_every_source_folder() {
             folders.push(dir);
         }
     }
+    // Every crate of the workspace (`members` of the root manifest) and of the bindings.
+    let manifest = std::fs::read_to_string("Cargo.toml").expect("root manifest");
+    let members = manifest
+        .lines()
+        .find_map(|l| l.strip_prefix("members = ["))
+        .expect("workspace members");
+    for member in members.split('"').skip(1).step_by(2) {
+        if member != "." && !folders.iter().any(|f| f == Path::new(member)) {
+            folders.push(PathBuf::from(member));
+        }
+    }
     for top in ["backends", "bindings"] {
         for entry in std::fs::read_dir(top).expect("folder") {
             let path = entry.expect("entry").path();
-            if path.join("Cargo.toml").exists() {
+            if path.join("Cargo.toml").exists() && !folders.contains(&path) {
                 folders.push(path);
             }
         }

@@ -1,6 +1,6 @@
 //! Ensembles: statistics against the realizations computed one by one, failed realizations
-//! reported with their seed while the others complete, and a restart — of the library run and
-//! of a killed CLI run — that gives the uninterrupted result.
+//! reported with their seed while the others complete, and a restart that gives the
+//! uninterrupted result (the killed CLI run: `cli/tests/ensemble.rs`).
 
 use fibercell::ensemble::{run_ensemble, EnsembleOptions};
 use fibercell::generate::{CellParams, FiberAmount};
@@ -9,8 +9,6 @@ use fibercell::io::read_cell_params;
 use fibercell::solve::SolveOptions;
 use fibercell::Model;
 use std::path::Path;
-use std::process::Command;
-use std::time::{Duration, Instant};
 
 /// The small non-woven of the fixture catalog with `fibers` fibers: at 30 some seeds do not
 /// percolate (2 and 4 of 1–4), at 50 all of 1–6 do.
@@ -89,48 +87,6 @@ fn a_restarted_ensemble_reuses_the_stored_realizations_and_equals_a_fresh_one() 
     assert_eq!(abd(&resumed), abd(&fresh));
     assert_eq!(resumed.abd, fresh.abd);
     assert_eq!(resumed.convergence, fresh.convergence);
-}
-
-#[test]
-fn a_killed_cli_run_restarts_where_it_stopped() {
-    let work = tempfile::tempdir().unwrap();
-    let params = work.path().join("params.toml");
-    std::fs::write(&params, toml::to_string(&small_nonwoven(50)).unwrap()).unwrap();
-    let run = |dir: &Path| {
-        let mut c = Command::new(env!("CARGO_BIN_EXE_fibercell"));
-        c.args(["ensemble", "--params"])
-            .arg(&params)
-            .args(["-n", "6", "-d"])
-            .arg(dir);
-        c
-    };
-    let (killed, whole) = (work.path().join("killed"), work.path().join("whole"));
-    let mut child = run(&killed).spawn().unwrap();
-    // Kill it once two realizations are stored.
-    let start = Instant::now();
-    while !killed.join("realizations/seed-2.json").exists() {
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no realization stored"
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    child.kill().unwrap();
-    child.wait().unwrap();
-    assert!(
-        !killed.join("ensemble.json").exists(),
-        "the run finished before it was killed"
-    );
-    let restarted = run(&killed).output().unwrap();
-    assert!(restarted.status.success());
-    let log = String::from_utf8_lossy(&restarted.stderr);
-    assert!(
-        log.contains("seed 1: reused") && log.contains("seed 2: reused"),
-        "{log}"
-    );
-    assert!(run(&whole).output().unwrap().status.success());
-    let table = |d: &Path| std::fs::read_to_string(d.join("ensemble.csv")).unwrap();
-    assert_eq!(table(&killed), table(&whole));
 }
 
 /// Curves in an ensemble: per point the statistics of the realizations' own curves, each as

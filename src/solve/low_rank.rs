@@ -48,7 +48,7 @@ const PARALLEL_PRODUCT: usize = 1 << 20;
 /// One contact's change since the reference: of its block coefficients (ΔD) and of its load
 /// coefficients (Δχ, the load G χ including the products of the block with prescribed DOFs).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct ContactChange {
+pub struct ContactChange {
     pub contact: usize,
     pub stiffness: BlockCoefficients,
     pub load: Vector6<f64>,
@@ -105,7 +105,7 @@ fn columns_needed(e: &BlockCoefficients, f: &Vector6<f64>) -> usize {
 }
 
 /// A sparse column of U: (free DOF, value), DOFs distinct.
-pub(crate) type SparseColumn = Vec<(usize, f64)>;
+pub type SparseColumn = Vec<(usize, f64)>;
 
 fn dot(column: &SparseColumn, x: &[f64]) -> f64 {
     column.iter().map(|&(i, v)| v * x[i]).sum()
@@ -113,7 +113,7 @@ fn dot(column: &SparseColumn, x: &[f64]) -> f64 {
 
 /// The columns U and S = Uᵀ A₀⁻¹ U accumulated on one factorization A₀.
 #[derive(Clone)]
-pub(crate) struct LowRankCorrection {
+pub struct LowRankCorrection {
     n: usize,
     columns: Vec<SparseColumn>,
     /// Per contact: indices of its columns, in [`ORDER`].
@@ -171,7 +171,7 @@ fn one_vector_par(values: usize) -> Par {
 /// The factorized capacitance matrix I + E S of one set of changes: of the contacts whose
 /// block changed; those whose load changed alone (E = 0, e.g. a stuck contact with a new
 /// slip) only add their U Δχ.
-pub(crate) struct Capacitance {
+pub struct Capacitance {
     /// Per contact whose block changed: its columns and its E (row-major, in column order).
     blocks: Vec<(Vec<usize>, Vec<f64>)>,
     /// Their columns, block after block: the rows of the capacitance matrix.
@@ -259,7 +259,7 @@ fn negative_square_root(e: &[f64], k: usize) -> Option<Vec<f64>> {
 
 impl Capacitance {
     /// Its order R: the changed blocks' columns (Cholesky) or ranks (LU).
-    pub(crate) fn order(&self) -> usize {
+    pub fn order(&self) -> usize {
         match &self.factor {
             CapacitanceFactor::Cholesky { .. } => self.active.len(),
             CapacitanceFactor::Lu { factors, .. } => factors.iter().map(|f| f.rank).sum(),
@@ -267,14 +267,14 @@ impl Capacitance {
     }
 
     /// The number of load coefficients it goes with (every changed contact's columns).
-    pub(crate) fn loads(&self) -> usize {
+    pub fn loads(&self) -> usize {
         self.loaded.len()
     }
 }
 
 impl LowRankCorrection {
     /// No columns, for `contacts` contacts and `n` free DOFs.
-    pub(crate) fn new(n: usize, contacts: usize) -> Self {
+    pub fn new(n: usize, contacts: usize) -> Self {
         LowRankCorrection {
             n,
             columns: Vec::new(),
@@ -338,7 +338,7 @@ impl LowRankCorrection {
     /// `known(b₀)`, when it gives the reference without a solve (see
     /// [`super::affine_reference::AffineReferences`]), is taken instead, and the new columns
     /// are solved for alone.
-    pub(crate) fn extend_with_reference(
+    pub fn extend_with_reference(
         &mut self,
         a0: &mut dyn LinearSolver,
         changes: &[ContactChange],
@@ -540,7 +540,7 @@ impl LowRankCorrection {
 
     /// Factorizes I + E S for `changes` (each contact's columns must be there: see
     /// [`LowRankCorrection::extend`]).
-    pub(crate) fn capacitance(&self, changes: &[ContactChange]) -> Capacitance {
+    pub fn capacitance(&self, changes: &[ContactChange]) -> Capacitance {
         let loaded: Vec<usize> = changes
             .iter()
             .flat_map(|ch| self.owned[ch.contact].iter().copied())
@@ -749,7 +749,7 @@ impl LowRankCorrection {
 
     /// [`LowRankCorrection::solve_from`] when `reference` is not needed afterwards: a forward
     /// half is taken, and the backward half runs in place on it.
-    pub(crate) fn solve_from_taken(
+    pub fn solve_from_taken(
         &self,
         a0: &mut dyn LinearSolver,
         cap: &Capacitance,
@@ -765,7 +765,7 @@ impl LowRankCorrection {
 
     /// A₀⁻¹ b₀ for later [`LowRankCorrection::solve_from`]: its forward half when S comes from
     /// forward solves, else the full solution.
-    pub(crate) fn reference(
+    pub fn reference(
         &self,
         a0: &mut dyn LinearSolver,
         mut b0: Vec<f64>,
@@ -783,7 +783,7 @@ impl LowRankCorrection {
     /// `load` on the columns of `cap` ([`LowRankCorrection::active_load`]): one solve with A₀
     /// (one backward half from a forward reference), as A₀⁻¹ b = A₀⁻¹ b₀ + A₀⁻¹ U Δχ and
     /// Uᵀ A₀⁻¹ b = Uᵀ A₀⁻¹ b₀ + S Δχ.
-    pub(crate) fn solve_from(
+    pub fn solve_from(
         &self,
         a0: &mut dyn LinearSolver,
         cap: &Capacitance,
@@ -966,7 +966,7 @@ impl LowRankCorrection {
 
 /// A₀⁻¹ b₀ as [`LowRankCorrection::solve_from`] starts from it.
 #[derive(Clone, Debug)]
-pub(crate) enum Reference {
+pub enum Reference {
     /// The solution.
     Full(Vec<f64>),
     /// Its forward half f = L⁻¹ P Ŝ b₀ (factor row order), and Wᵀ f for the columns so far:

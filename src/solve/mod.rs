@@ -23,7 +23,16 @@ pub use incremental::{
     EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS,
     MAX_LOW_RANK_COLUMNS, MAX_SETTLED_RESIDUAL, STALLED_EQUILIBRIUM_TOLERANCE,
 };
-pub(crate) use low_rank::{ContactChange, LowRankCorrection, SparseColumn};
+pub(crate) use low_rank::ContactChange;
+/// The low-rank correction's internals, for `fibercell-bench`'s measurement of the solve after
+/// contact switches (feature `bench-internals`): not part of the API, they change without notice.
+#[cfg(feature = "bench-internals")]
+#[doc(hidden)]
+pub mod bench_internals {
+    pub use super::low_rank::{
+        Capacitance, ContactChange, LowRankCorrection, Reference, SparseColumn,
+    };
+}
 pub use matrix_solve::{
     solve_matrix, MatrixSolveReport, MatrixSolver, MATRIX_SOLVE_BACKWARD_ERROR,
 };

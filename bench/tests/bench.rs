@@ -2,8 +2,8 @@
 //! and consistent with the others (same matrix for every backend, the factor-reuse solve
 //! converges after one switch, the curve runs), and bad options are typed errors.
 
-use fibercell::bench::{markdown, reproduce_command, run_bench, splice_readme, BenchOptions};
 use fibercell::Error;
+use fibercell_bench::{markdown, reproduce_command, run_bench, splice_readme, BenchOptions};
 
 #[test]
 fn the_small_cell_runs_every_stage() {
@@ -137,4 +137,21 @@ fn the_readme_tables_are_spliced_between_the_markers_only() {
     let spliced = splice_readme(&quoted, "| a | b |\n", "fibercell bench").expect("markers");
     assert!(spliced.starts_with("See `<!-- bench:start -->` below.\n# T\n"));
     assert!(spliced.contains("<!-- bench:start -->\n\nReproduce"));
+}
+
+/// docs/performance.md's tables are generated from the committed report: rendering
+/// `benches/results/bench.json` again into the page changes nothing (after a new run, write both
+/// with `--json benches/results/bench.json --readme docs/performance.md`).
+#[test]
+fn the_performance_page_is_the_rendering_of_the_committed_report() {
+    let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
+    let json = std::fs::read_to_string(root.join("benches/results/bench.json")).expect("report");
+    let report: fibercell_bench::BenchReport = serde_json::from_str(&json).expect("a bench report");
+    let page = std::fs::read_to_string(root.join("docs/performance.md")).expect("page");
+    let rendered = splice_readme(&page, &markdown(&report), &reproduce_command(&report))
+        .expect("the page has the bench markers");
+    assert!(
+        rendered == page,
+        "docs/performance.md differs from the rendering of benches/results/bench.json"
+    );
 }

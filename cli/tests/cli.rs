@@ -2,13 +2,13 @@
 //! a non-zero exit code.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
+
+mod common;
+use common::{at_root, fibercell};
 
 fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fibercell"))
-        .args(args)
-        .output()
-        .expect("runs")
+    fibercell().args(args).output().expect("runs")
 }
 
 /// `generate nonwoven --params PARAMS -o OUT`, which must succeed.
@@ -103,7 +103,7 @@ fn export_matrix_writes_the_lower_triangle() {
         .map(|x| x.parse().unwrap())
         .collect();
     // Compare with the library's reduced system.
-    let m = fibercell::io::load_model(Path::new("fixtures/ok_frame3d.toml")).unwrap();
+    let m = fibercell::io::load_model(&at_root("fixtures/ok_frame3d.toml")).unwrap();
     let sys = fibercell::solve::ReducedSystem::assemble(&m, Default::default()).unwrap();
     let a = sys.matrix().unwrap();
     assert_eq!(header[0], a.nrows());
@@ -455,7 +455,7 @@ fn generate_nonwoven_writes_a_cell_that_stats_reads() {
     ] {
         fails_saying(&args, needle);
     }
-    assert!(!std::path::Path::new("x.toml").exists() && !std::path::Path::new("x.vtu").exists());
+    assert!(!at_root("x.toml").exists() && !at_root("x.vtu").exists());
 }
 
 #[test]
@@ -534,8 +534,7 @@ fn convert_round_trips_through_abaqus_and_writes_paraview_files() {
         let o = run(&["convert", from, to]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
-    let a =
-        fibercell::io::read_description(Path::new("fixtures/cells/knitted_small.toml")).unwrap();
+    let a = fibercell::io::read_description(&at_root("fixtures/cells/knitted_small.toml")).unwrap();
     let b = fibercell::io::read_description(&toml).unwrap();
     assert_eq!(a, b);
     let pvd = out.join("cell.pvd");
@@ -672,7 +671,7 @@ fn export_matrix_of_a_cell_writes_its_cell_problems() {
         &std::fs::read_to_string(dir.join("K_rhs.mtx")).expect("rhs"),
     )
     .expect("reads back");
-    let model = fibercell::io::load_model(Path::new("fixtures/woven_plain.toml")).expect("model");
+    let model = fibercell::io::load_model(&at_root("fixtures/woven_plain.toml")).expect("model");
     let want = fibercell::homogenize::cell_problem(&model).expect("cell problem");
     // The lower triangle is written exactly (the upper one mirrors it; the assembled one
     // equals it to roundoff).
@@ -853,7 +852,7 @@ fn an_interrupted_run_leaves_no_temporary_files_nor_an_old_json() {
     std::fs::create_dir_all(&out).unwrap();
     let stale = out.join("curve.json");
     std::fs::write(&stale, "{\"from\": \"an earlier run\"}").unwrap();
-    let child = std::process::Command::new(env!("CARGO_BIN_EXE_fibercell"))
+    let child = fibercell()
         .args([
             "curve",
             "fixtures/cells/nonwoven_small.toml",

@@ -1,5 +1,5 @@
 //! The throughput benchmark behind `fibercell bench`: generated non-woven cells S, M and L
-//! ([`crate::generate::nonwoven_preset`]), every stage timed separately (generation, contact
+//! ([`fibercell::generate::nonwoven_preset`]), every stage timed separately (generation, contact
 //! search, pattern, value fill, symbolic analysis, numeric factorization and solve per backend,
 //! the solve after contact switches on the previous factor, the six elastic cell problems, an
 //! elasto-plastic curve), with nnz(K), nnz(L), flops and peak memory, and the machine's own
@@ -13,7 +13,7 @@ pub use cell::{bench_cell, BackendBench, CellBench, CurveBench, ReuseBench};
 pub use machine::{dgemm_gflops, measure_machine, peak_memory_bytes, triad_bandwidth, Machine};
 pub use report::{markdown, reproduce_command, splice_readme, README_MARKERS, REPORT_PATH};
 
-use crate::Error;
+use fibercell::Error;
 use serde::{Deserialize, Serialize};
 
 /// Default wall-clock limit of one curve (s).
@@ -41,7 +41,7 @@ pub struct BenchOptions {
     /// report projects the rest (None: no limit).
     pub curve_time_limit: Option<f64>,
     /// Tresca bound of the contacts in the mild curve (N), which runs on bonded contacts (see
-    /// [`crate::solve::IncrementalOptions::bonded`]).
+    /// [`fibercell::solve::IncrementalOptions::bonded`]).
     pub tresca_bound: f64,
 }
 
@@ -96,7 +96,7 @@ pub fn run_bench(opts: &BenchOptions, log: &mut dyn FnMut(&str)) -> Result<Bench
         ));
     }
     for c in &opts.cells {
-        crate::generate::nonwoven_preset(c, opts.seed)?;
+        fibercell::generate::nonwoven_preset(c, opts.seed)?;
     }
     log("machine: DGEMM and memory bandwidth");
     let machine = measure_machine(2048, 1 << 25);

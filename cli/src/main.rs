@@ -292,7 +292,7 @@ enum Command {
         #[arg(long, default_value_t = 100)]
         curve_steps: usize,
         /// Wall-clock limit of one curve in seconds: it stops there and the rest is projected.
-        #[arg(long, default_value_t = fibercell::bench::DEFAULT_CURVE_TIME_LIMIT)]
+        #[arg(long, default_value_t = fibercell_bench::DEFAULT_CURVE_TIME_LIMIT)]
         curve_time_limit: f64,
         /// Do not run: render the report of an earlier --json file.
         #[arg(long)]
@@ -602,11 +602,11 @@ fn parse_strain(s: &str) -> Result<fibercell::cell::MacroStrain, String> {
 }
 
 fn bench(
-    opts: fibercell::bench::BenchOptions,
+    opts: fibercell_bench::BenchOptions,
     from_json: Option<&Path>,
     [json, markdown, readme]: [Option<&Path>; 3],
 ) -> Result<(), Error> {
-    use fibercell::bench;
+    use fibercell_bench as bench;
     let report: bench::BenchReport = match from_json {
         Some(p) => {
             let text = io::read_text(p)?;
@@ -1743,7 +1743,7 @@ fn main() -> ExitCode {
             from_json,
             readme,
         } => bench(
-            fibercell::bench::BenchOptions {
+            fibercell_bench::BenchOptions {
                 cells,
                 seed,
                 repeats,

@@ -5,18 +5,16 @@
 
 use super::machine::peak_memory_bytes;
 use super::BenchOptions;
-use crate::cell::pair_boundary_nodes;
-use crate::contact::{find_candidates, ContactSet};
-use crate::generate::{nonwoven, nonwoven_preset};
-use crate::homogenize::{
+use fibercell::cell::pair_boundary_nodes;
+use fibercell::contact::{find_candidates, ContactSet};
+use fibercell::generate::{nonwoven, nonwoven_preset};
+use fibercell::homogenize::{
     elasto_plastic_curve, homogenize_elastic, ContactStiffness, CurveOptions, PeriodicSystem,
 };
-use crate::model::{FrictionSpec, Model};
-use crate::solve::{
-    ContactChange, IncrementalOptions, LowRankCorrection, SolveOptions, SolverConfig, SolverKind,
-    SparseColumn,
-};
-use crate::Error;
+use fibercell::model::{FrictionSpec, Model};
+use fibercell::solve::bench_internals::{ContactChange, LowRankCorrection, SparseColumn};
+use fibercell::solve::{IncrementalOptions, SolveOptions, SolverConfig, SolverKind};
+use fibercell::Error;
 use fibercell_solver::{backward_error, pcg_with_factor, CscRef, FillOrdering};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -106,7 +104,7 @@ pub struct ReuseBench {
     #[serde(default)]
     pub cholmod_refactorization_seconds: Option<f64>,
     /// CHOLMOD's downdate of its factor by the switched contacts' stick springs (rank 2k,
-    /// [`crate::homogenize::StickSystem::stick_spring_columns`]) plus one solve (s), the
+    /// [`fibercell::homogenize::StickSystem::stick_spring_columns`]) plus one solve (s), the
     /// first after a factorization: it includes copying the supernodal factor into a
     /// simplicial LDLᵀ. Absent without the cholmod feature.
     #[serde(default)]
@@ -233,7 +231,7 @@ pub struct CurveBench {
     /// Numeric factorizations in all.
     pub factorizations: usize,
     /// Solves on an earlier factorization with a low-rank correction (see
-    /// [`crate::solve::IncrementalOptions::reuse_factor`]).
+    /// [`fibercell::solve::IncrementalOptions::reuse_factor`]).
     pub factor_reuses: usize,
     /// Residual correction steps of those solves (absent in reports written before).
     #[serde(default)]
@@ -259,7 +257,7 @@ pub struct CurveBench {
     #[serde(default)]
     pub stabilization_share: f64,
     /// Seconds of the completed increments per stage: assemble, factorize, factor reuse,
-    /// solve, classify, commit ([`crate::solve::IncrementTimings::NAMES`]); absent in reports
+    /// solve, classify, commit ([`fibercell::solve::IncrementTimings::NAMES`]); absent in reports
     /// written before it was measured.
     #[serde(default)]
     pub stages: Option<[f64; 6]>,
@@ -326,7 +324,7 @@ pub struct CellBench {
     /// The six elastic cell problems (and Θ) end to end, median (s).
     pub six_cell_problems: f64,
     /// Their stages (of the median run).
-    pub six_cell_problem_stages: crate::homogenize::HomogenizeTimings,
+    pub six_cell_problem_stages: fibercell::homogenize::HomogenizeTimings,
     /// The default elasto-plastic curve (None when skipped).
     pub curve: Option<CurveBench>,
     /// The mild-strain Tresca curve of earlier reports (None when skipped).
@@ -440,7 +438,7 @@ fn low_rank_switch(
         let (rows, vals) = w.col(2 * j + k - 1);
         rows.iter().copied().zip(vals.iter().copied()).collect()
     };
-    let mut stiffness = crate::contact::BlockCoefficients::zeros();
+    let mut stiffness = fibercell::contact::BlockCoefficients::zeros();
     stiffness[(1, 1)] = -1.0;
     stiffness[(2, 2)] = -1.0;
     let changes: Vec<ContactChange> = (0..list.len())
@@ -591,7 +589,7 @@ fn bench_reuse(
 }
 
 fn bench_curve(
-    model_desc: &crate::model::ModelDescription,
+    model_desc: &fibercell::model::ModelDescription,
     case: &CurveCase,
     opts: &BenchOptions,
 ) -> Result<CurveBench, Error> {
@@ -663,7 +661,7 @@ fn bench_curve(
 }
 
 /// Fills `bench` from the curve `c` of `steps` increments.
-fn record_curve(bench: &mut CurveBench, c: &crate::homogenize::Curve, steps: usize) {
+fn record_curve(bench: &mut CurveBench, c: &fibercell::homogenize::Curve, steps: usize) {
     let inc = &c.solution.increments;
     let secs: Vec<f64> = inc.iter().map(|r| r.seconds).collect();
     let spent: f64 = secs.iter().sum();
@@ -696,7 +694,7 @@ fn record_curve(bench: &mut CurveBench, c: &crate::homogenize::Curve, steps: usi
             0.0
         }
     });
-    let mut stages = crate::solve::IncrementTimings::default();
+    let mut stages = fibercell::solve::IncrementTimings::default();
     inc.iter().for_each(|r| stages.add(&r.timings));
     bench.stages = Some(stages.stages());
     bench.sliding_at_end = inc.last().map_or(0, |r| r.slip);
@@ -728,7 +726,7 @@ pub fn bench_cell(
     let elements = model.elements().len();
     // Refills of one buffer, as in the incremental hot path; zeroing is not timed.
     let mut buffer = sys.zero_values();
-    let mut refill = |add: &dyn Fn(&mut crate::homogenize::PeriodicValues)| {
+    let mut refill = |add: &dyn Fn(&mut fibercell::homogenize::PeriodicValues)| {
         median(
             (0..short_repeats)
                 .map(|_| {

@@ -3,12 +3,16 @@
 //! and a restart that reuses the stored realizations.
 #![cfg(feature = "mpi")]
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
 /// The small non-woven of the fixture catalog with 30 fibers: seeds 2 and 4 do not percolate.
 fn params_file(dir: &Path) -> std::path::PathBuf {
-    let text = std::fs::read_to_string("fixtures/cells/nonwoven_small.params.toml").unwrap();
+    let text =
+        std::fs::read_to_string(common::at_root("fixtures/cells/nonwoven_small.params.toml"))
+            .unwrap();
     let path = dir.join("params.toml");
     std::fs::write(&path, text.replace("fibers = 140", "fibers = 30")).unwrap();
     path
@@ -43,10 +47,7 @@ fn mpirun(args: &[std::ffi::OsString]) -> Output {
 }
 
 fn single(args: &[std::ffi::OsString]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_fibercell"))
-        .args(args)
-        .output()
-        .unwrap();
+    let out = common::fibercell().args(args).output().unwrap();
     assert!(
         out.status.success(),
         "{}",

@@ -166,7 +166,10 @@ pub fn markdown(r: &BenchReport) -> String {
             }),
         );
         row(
-            &format!("… {}", crate::solve::IncrementTimings::NAMES.join(" / ")),
+            &format!(
+                "… {}",
+                fibercell::solve::IncrementTimings::NAMES.join(" / ")
+            ),
             &curve_cell(pick, &|k| {
                 k.stages.map_or("–".into(), |s| {
                     s.iter().map(|&t| ms(t)).collect::<Vec<_>>().join(" / ")
