@@ -13,7 +13,7 @@ use fibercell::model::{
     CellSpec, ContactPairSpec, ContactSpec, FiberSpec, FrictionSpec, MaterialSpec,
     ModelDescription, NodeSpec, SideSpec,
 };
-use fibercell::solve::{IncrementalOptions, SolveOptions};
+use fibercell::solve::{History, IncrementalOptions, SolveOptions};
 use fibercell::{Error, Model};
 
 const LX: f64 = 4e-3;
@@ -373,4 +373,49 @@ fn a_past_deadline_stops_the_curve_after_one_increment() {
     assert_eq!(full.points.len(), 3);
     assert_eq!(boxed.points.len(), 1);
     assert_eq!(boxed.points[0].resultant, full.points[0].resultant);
+}
+
+/// A curve keeps the full outputs (displacements, contact records) of its last increment only,
+/// unless asked for all: the points, switches and every increment's contact states are the
+/// same either way, the last increment's outputs too, and the earlier ones are empty. Here
+/// one contact slides from the eighth of 20 increments, so the states show the switch.
+#[test]
+fn a_curve_keeps_the_last_increments_outputs_unless_asked_for_all() {
+    let d = cell(
+        0.37 * curve(&cell(1e6), 1, false).solution.contact_results[0][0].tangential_magnitude,
+    );
+    let with = |history| {
+        run(
+            &d,
+            CurveOptions {
+                strain: SHEAR,
+                steps: 20,
+                unload: true,
+                incremental: IncrementalOptions {
+                    history,
+                    ..IncrementalOptions::default()
+                },
+            },
+        )
+    };
+    let (last, all) = (with(History::Auto), with(History::All));
+    assert_eq!(last.points, all.points);
+    assert_eq!(last.switches.len(), all.switches.len());
+    assert!(!all.switches.is_empty());
+    let (l, a) = (&last.solution, &all.solution);
+    assert_eq!(l.contact_states, a.contact_states);
+    assert_eq!(l.contact_states.len(), 60);
+    let n = l.increments.len();
+    assert_eq!((l.displacements.len(), l.contact_results.len()), (n, n));
+    assert!(l.displacements[..n - 1].iter().all(Vec::is_empty));
+    assert!(l.contact_results[..n - 1].iter().all(Vec::is_empty));
+    assert_eq!(l.displacements[n - 1], a.displacements[n - 1]);
+    assert_eq!(l.contact_results[n - 1], a.contact_results[n - 1]);
+    assert!(a.displacements.iter().all(|u| !u.is_empty()));
+    // The 59 emptied increments' outputs are what the run no longer holds.
+    let record = size_of::<fibercell::solve::ContactRecord>();
+    let per = 48 * a.displacements[0].len() + record * a.contact_results[0].len();
+    assert!(per > 0);
+    assert!(a.memory_bytes() - l.memory_bytes() >= (n - 1) * per);
+    assert!(l.memory_bytes() >= per);
 }

@@ -263,6 +263,14 @@ pub struct CurveBench {
     pub stages: Option<[f64; 6]>,
     /// The error, when the curve failed.
     pub error: Option<String>,
+    /// The most bytes the low-rank correction held in any increment (columns of U, their
+    /// forward solves, S and a capacitance factorization; absent in reports before it).
+    #[serde(default)]
+    pub low_rank_bytes: Option<usize>,
+    /// Bytes of the run's per-increment outputs at its end (every increment's displacements
+    /// and contact records; absent in reports before it).
+    #[serde(default)]
+    pub output_bytes: Option<usize>,
 }
 
 fn mild_name() -> String {
@@ -332,6 +340,9 @@ pub struct CellBench {
     pub mild_curve: Option<CurveBench>,
     /// Peak resident memory of the process after this cell (bytes).
     pub peak_memory: Option<u64>,
+    /// Bytes of the large structures of the cell problems (absent in reports before them).
+    #[serde(default)]
+    pub memory: Option<MemoryBench>,
 }
 
 /// The backends that apply: faer Cholesky with each ordering, CHOLMOD (with the feature) with
@@ -652,6 +663,8 @@ fn bench_curve(
         stabilization_share: 0.0,
         stages: None,
         error: None,
+        low_rank_bytes: None,
+        output_bytes: None,
     };
     match result {
         Ok(c) => record_curve(&mut bench, &c, opts.curve_steps),
@@ -698,6 +711,19 @@ fn record_curve(bench: &mut CurveBench, c: &fibercell::homogenize::Curve, steps:
     inc.iter().for_each(|r| stages.add(&r.timings));
     bench.stages = Some(stages.stages());
     bench.sliding_at_end = inc.last().map_or(0, |r| r.slip);
+    bench.low_rank_bytes = inc.iter().map(|r| r.low_rank.largest_bytes).max();
+    bench.output_bytes = Some(c.solution.memory_bytes());
+}
+
+/// Bytes held by the cell problems' large structures.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MemoryBench {
+    /// The pattern of K (CSC structure and the element blocks' slot maps).
+    pub pattern: usize,
+    /// The values of K.
+    pub values: usize,
+    /// The values of faer's Cholesky factor with the default ordering, 8 · nnz(L).
+    pub factor: usize,
 }
 
 /// Runs every stage on the preset `cell`.
@@ -797,6 +823,7 @@ pub fn bench_cell(
     });
     let mild_curve = curves[1].take().transpose()?;
     let curve = curves[0].take().transpose()?;
+    let factor_bytes = 8 * backend_results[0].nnz_l.unwrap_or(0);
     Ok(CellBench {
         cell: cell.to_string(),
         fibers: generated.report.deposited,
@@ -825,5 +852,10 @@ pub fn bench_cell(
         curve,
         mild_curve,
         peak_memory: peak_memory_bytes(),
+        memory: Some(MemoryBench {
+            pattern: sys.pattern.memory_bytes(),
+            values: values.values.capacity() * size_of::<f64>(),
+            factor: factor_bytes,
+        }),
     })
 }

@@ -9,7 +9,7 @@ mod cell;
 mod machine;
 mod report;
 
-pub use cell::{bench_cell, BackendBench, CellBench, CurveBench, ReuseBench};
+pub use cell::{bench_cell, BackendBench, CellBench, CurveBench, MemoryBench, ReuseBench};
 pub use machine::{dgemm_gflops, measure_machine, peak_memory_bytes, triad_bandwidth, Machine};
 pub use report::{markdown, reproduce_command, splice_readme, README_MARKERS, REPORT_PATH};
 

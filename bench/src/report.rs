@@ -18,6 +18,10 @@ fn ms(s: f64) -> String {
     }
 }
 
+fn mb(bytes: usize) -> String {
+    format!("{:.0} MB", bytes as f64 / 1e6)
+}
+
 fn per_second(v: f64) -> String {
     format!("{:.2e}/s", v)
 }
@@ -176,6 +180,21 @@ pub fn markdown(r: &BenchReport) -> String {
                 })
             }),
         );
+        if r.cells
+            .iter()
+            .any(|c| pick(c).is_some_and(|k| k.output_bytes.is_some()))
+        {
+            row(
+                &format!("{label}: memory: low-rank correction (peak) / outputs at the end"),
+                &curve_cell(pick, &|k| {
+                    format!(
+                        "{} / {}",
+                        opt(k.low_rank_bytes.map(mb)),
+                        opt(k.output_bytes.map(mb))
+                    )
+                }),
+            );
+        }
         row(
             &format!("{label}: sliding at end / held / max residual / stabilization work"),
             &curve_cell(pick, &|k| {
@@ -185,6 +204,13 @@ pub fn markdown(r: &BenchReport) -> String {
                 )
             }),
         );
+    }
+    if r.cells.iter().any(|c| c.memory.is_some()) {
+        row("memory: pattern / values of K / faer's factor", &|c| {
+            c.memory.as_ref().map_or("–".into(), |m| {
+                format!("{} / {} / {}", mb(m.pattern), mb(m.values), mb(m.factor))
+            })
+        });
     }
     row("peak memory", &|c| {
         opt(c.peak_memory.map(|b| format!("{:.2} GB", b as f64 / 1e9)))

@@ -130,6 +130,13 @@ impl Pattern {
         )))
     }
 
+    /// Bytes it holds: the CSC structure and the element blocks' slot maps.
+    pub fn memory_bytes(&self) -> usize {
+        let usizes =
+            self.col_ptr.capacity() + self.row_idx.capacity() + self.block_offsets.capacity();
+        usizes * size_of::<usize>() + self.slots.capacity() * size_of::<u32>()
+    }
+
     /// Stored entries (both triangles).
     pub fn nnz(&self) -> usize {
         self.row_idx.len()

@@ -10,7 +10,7 @@ use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
 use crate::model::Model;
 use crate::solve::{
-    run_incremental, DriverCouplings, IncrementalOptions, IncrementalSolution, OnAllStick,
+    run_incremental, DriverCouplings, History, IncrementalOptions, IncrementalSolution, OnAllStick,
 };
 use crate::Error;
 use serde::Serialize;
@@ -181,9 +181,15 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
         path.extend((0..n).rev().map(|k| k as f64 / n as f64));
         path.extend((1..=n).map(|k| k as f64 / n as f64));
     }
+    // The points and switches need every increment's summary and contact states only.
+    let history = match opts.incremental.history {
+        History::Auto => History::Last,
+        h => h,
+    };
     let inc = IncrementalOptions {
         steps: path.len(),
         path: Some(path),
+        history,
         ..opts.incremental.clone()
     };
     let area = p.geometry.area();
@@ -237,19 +243,19 @@ pub fn elasto_plastic_curve(model: &Model, opts: &CurveOptions) -> Result<Curve,
     // Switches: a contact's state differs from the previous increment (initial: from the first).
     let mut switches = Vec::new();
     for (k, point) in points.iter().enumerate().skip(1) {
-        for (c, (now, before)) in sol.contact_results[k]
+        for (c, (now, before)) in sol.contact_states[k]
             .iter()
-            .zip(&sol.contact_results[k - 1])
+            .zip(&sol.contact_states[k - 1])
             .enumerate()
         {
-            if now.state != before.state {
+            if now != before {
                 switches.push(SwitchEvent {
                     contact: c + 1,
                     step: k + 1,
                     strain: point.strain,
                     estimated_strain: point.strain,
-                    from: before.state.name(),
-                    to: now.state.name(),
+                    from: before.name(),
+                    to: now.name(),
                 });
             }
         }

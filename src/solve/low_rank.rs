@@ -270,6 +270,23 @@ impl Capacitance {
     pub fn loads(&self) -> usize {
         self.loaded.len()
     }
+
+    /// Bytes it holds: the factorized matrix of order R and its blocks' factors.
+    pub(crate) fn memory_bytes(&self) -> usize {
+        let f64s = |v: &Vec<f64>| v.capacity() * size_of::<f64>();
+        let usizes = |v: &Vec<usize>| v.capacity() * size_of::<usize>();
+        let blocks: usize = self.blocks.iter().map(|(c, e)| usizes(c) + f64s(e)).sum();
+        let factor = match &self.factor {
+            CapacitanceFactor::Cholesky { c, l } => c.iter().map(f64s).sum::<usize>() + f64s(l),
+            CapacitanceFactor::Lu { factors, .. } => {
+                let order = self.order();
+                let pivots = 2 * order * size_of::<usize>();
+                let ranks: usize = factors.iter().map(|f| f64s(&f.x) + f64s(&f.y)).sum();
+                order * order * size_of::<f64>() + pivots + ranks
+            }
+        };
+        blocks + usizes(&self.active) + usizes(&self.loaded) + factor
+    }
 }
 
 impl LowRankCorrection {
@@ -305,6 +322,22 @@ impl LowRankCorrection {
     /// Columns of U so far.
     pub(crate) fn len(&self) -> usize {
         self.columns.len()
+    }
+
+    /// Bytes it holds: the columns of U, their forward solves (block by block) and S.
+    pub(crate) fn memory_bytes(&self) -> usize {
+        let entry = size_of::<(usize, f64)>();
+        let columns: usize = self.columns.iter().map(|c| c.capacity() * entry).sum();
+        let owned: usize = self.owned.iter().map(|o| o.capacity()).sum::<usize>() * 8;
+        let s = self.s.nrows().max(self.s.col_stride().unsigned_abs()) * self.s.ncols() * 8;
+        let forward: usize = match &self.mode {
+            ColumnMode::Forward(blocks) => blocks
+                .values()
+                .map(|b| (b.values.capacity() + b.columns.capacity()) * 8)
+                .sum(),
+            ColumnMode::Unknown | ColumnMode::Solves => 0,
+        };
+        columns + owned + s + forward
     }
 
     /// The order of the capacitance matrix of `changes` (the ranks of their blocks) and how
@@ -1176,6 +1209,17 @@ pub(super) mod tests {
             .extend(solver.as_mut(), &changes, column)
             .expect("extend");
         assert_eq!(low_rank.len(), 11);
+        // Its memory: S of order 11 and the columns' entries (16 bytes each), plus with forward
+        // solves their rows of W (at most n doubles and a column index per column and block).
+        let entries: usize = low_rank.columns.iter().map(Vec::len).sum();
+        let least = 8 * 11 * 11 + 16 * entries;
+        let bytes = low_rank.memory_bytes();
+        assert!(
+            least <= bytes && bytes <= 2 * least + 16 * n * 11 + 1024,
+            "{bytes} B, {least} B at least"
+        );
+        let cap = low_rank.capacitance(&changes);
+        assert!(cap.memory_bytes() >= 8 * cap.order() * cap.order());
         assert_eq!(
             matches!(low_rank.mode, ColumnMode::Forward(_)),
             forward,

@@ -18,7 +18,7 @@ pub use connectivity::{check_supported, check_supported_with};
 pub use increment_timings::IncrementTimings;
 pub(crate) use incremental::{gather, run_incremental, Advanced, OnAllStick, RunState, Setup};
 pub use incremental::{
-    solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, IncrementRecord,
+    solve_incremental, ContactRecord, DriverCouplings, EnergyBalance, History, IncrementRecord,
     IncrementalOptions, IncrementalSolution, LowRankSizes, Progress, ProgressFn, BOUND_TOLERANCE,
     EQUILIBRIUM_TOLERANCE, MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS,
     MAX_LOW_RANK_COLUMNS, MAX_SETTLED_RESIDUAL, STALLED_EQUILIBRIUM_TOLERANCE,

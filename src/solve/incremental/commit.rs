@@ -155,6 +155,7 @@ impl StickSlip<'_, '_, '_> {
             timings: inc.timings,
             low_rank: LowRankSizes {
                 largest_order: inc.low_rank_order,
+                largest_bytes: inc.low_rank_bytes.max(factors.low_rank.memory_bytes()),
                 columns: factors.low_rank.len(),
                 crossover_order: factors.cost.crossover(),
             },
@@ -163,6 +164,17 @@ impl StickSlip<'_, '_, '_> {
             equilibrium_residual,
             energy: balance,
         });
+        if !setup.opts.history.keeps_all(true) {
+            // Only the last increment keeps its full outputs: free the one before.
+            if let (Some(r), Some(d)) =
+                (out.contact_results.last_mut(), out.displacements.last_mut())
+            {
+                *r = Vec::new();
+                *d = Vec::new();
+            }
+        }
+        out.contact_states
+            .push(records.iter().map(|r| r.state).collect());
         out.contact_results.push(records);
         out.displacements.push(disc.physical(q));
         out.reactions = reactions;

@@ -82,6 +82,7 @@ impl StickSlip<'_, '_, '_> {
         self.out.reactions = s.reactions;
         self.out.increments.truncate(s.records);
         self.out.contact_results.truncate(s.records);
+        self.out.contact_states.truncate(s.records);
         self.out.displacements.truncate(s.records);
     }
 
@@ -95,6 +96,7 @@ impl StickSlip<'_, '_, '_> {
         }
         let first = out.increments.remove(n - 2);
         out.contact_results.remove(n - 2);
+        out.contact_states.remove(n - 2);
         out.displacements.remove(n - 2);
         if let Some(last) = out.increments.last_mut() {
             merge_halves(last, &first, attempt.as_ref());

@@ -236,6 +236,9 @@ impl StickSlip<'_, '_, '_> {
                 / started.elapsed().as_secs_f64().max(1e-9))
             .max(1e8);
         }
+        inc.low_rank_bytes = inc
+            .low_rank_bytes
+            .max(low_rank.memory_bytes() + cap.memory_bytes());
         let load = low_rank.active_load(changes);
         let first = low_rank.solve_from(a0.as_mut(), &cap, &x0, &load);
         factors.reference_solution = Some(x0);

@@ -25,6 +25,8 @@ pub(super) struct Increment {
     pub reuse_iterations: usize,
     /// Largest capacitance order of the low-rank solves.
     pub low_rank_order: usize,
+    /// The most bytes the low-rank correction held with a capacitance factorization.
+    pub low_rank_bytes: usize,
     pub timings: IncrementTimings,
     pub started: Instant,
     clock: Instant,
@@ -61,6 +63,7 @@ impl Increment {
             factor_reuses: 0,
             reuse_iterations: 0,
             low_rank_order: 0,
+            low_rank_bytes: 0,
             timings: IncrementTimings::default(),
             started,
             clock: started,

@@ -48,7 +48,7 @@ mod stabilizer;
 
 pub use driver_couplings::DriverCouplings;
 pub use options::{
-    IncrementalOptions, Progress, ProgressFn, BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE,
+    History, IncrementalOptions, Progress, ProgressFn, BOUND_TOLERANCE, EQUILIBRIUM_TOLERANCE,
     MAX_CONTACT_RECORDS, MAX_CUTBACKS, MAX_HELD_RESIDUAL, MAX_INCREMENTS, MAX_LOW_RANK_COLUMNS,
     MAX_SETTLED_RESIDUAL, STALLED_EQUILIBRIUM_TOLERANCE,
 };
@@ -222,6 +222,7 @@ impl<'s, 'a, 'h> StickSlip<'s, 'a, 'h> {
                 contacts: Arc::clone(&setup.set),
                 increments: Vec::new(),
                 contact_results: Vec::new(),
+                contact_states: Vec::new(),
                 displacements: Vec::new(),
                 reactions: Vec::new(),
             },

@@ -69,6 +69,9 @@ pub struct IncrementalOptions {
     /// current one have cost a factorization. A bound makes the choice independent of the
     /// machine's timings.
     pub max_capacitance_order: Option<usize>,
+    /// Which increments keep their full outputs: displacements of every node and record of
+    /// every contact (every increment keeps its summary and its contacts' states).
+    pub history: History,
     /// Stop after the increment during which this instant passes (default: none); the solution
     /// then holds fewer increments than the path. A time box, e.g. for a benchmark.
     pub deadline: Option<std::time::Instant>,
@@ -136,6 +139,36 @@ pub(super) const BOUND_RELAXATION_AFTER: usize = 10;
 /// contact's changes of direction or bound count as switches (see [`CHATTER_SWITCHES`]).
 pub(super) const SETTLING_ITERATIONS: usize = 20;
 
+/// Which increments of a run keep their full outputs, [`IncrementalSolution::displacements`]
+/// and [`IncrementalSolution::contact_results`], which on a large cell take more memory than
+/// the factorization within a few hundred increments (the summaries and contact states of
+/// every increment are always kept).
+///
+/// [`IncrementalSolution::displacements`]: super::IncrementalSolution::displacements
+/// [`IncrementalSolution::contact_results`]: super::IncrementalSolution::contact_results
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum History {
+    /// By job: every increment for `solve_incremental` (its files show each step), the last
+    /// for `elasto_plastic_curve` (its points and switches need the summaries and states).
+    #[default]
+    Auto,
+    /// Every increment.
+    All,
+    /// The last increment only; the earlier increments' vectors are left empty.
+    Last,
+}
+
+impl History {
+    /// Whether a run keeps every increment, `Auto` meaning `all_by_default`.
+    pub fn keeps_all(self, all_by_default: bool) -> bool {
+        match self {
+            History::Auto => all_by_default,
+            History::All => true,
+            History::Last => false,
+        }
+    }
+}
+
 impl Default for IncrementalOptions {
     fn default() -> Self {
         IncrementalOptions {
@@ -151,6 +184,7 @@ impl Default for IncrementalOptions {
             max_low_rank_columns: MAX_LOW_RANK_COLUMNS,
             max_capacitance_order: None,
             deadline: None,
+            history: History::Auto,
             consistent_coulomb_tangent: false,
             max_cutbacks: MAX_CUTBACKS,
         }

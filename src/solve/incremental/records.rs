@@ -81,6 +81,9 @@ pub struct LowRankSizes {
     /// Largest capacitance order (columns of U in play) of the increment's low-rank solves
     /// (0: none).
     pub largest_order: usize,
+    /// The most memory the correction held in the increment (bytes): the columns of U, their
+    /// forward solves, S = Uᵀ A₀⁻¹ U and a capacitance factorization.
+    pub largest_bytes: usize,
     /// Columns of U kept on the reference factorization at the end of the increment.
     pub columns: usize,
     /// The order at which a capacitance factorization is predicted to cost as much as a
@@ -141,10 +144,36 @@ pub struct IncrementalSolution {
     pub contacts: Arc<ContactSet>,
     /// Per-increment summary.
     pub increments: Vec<IncrementRecord>,
-    /// Per increment, every contact.
+    /// Per increment, every contact (empty for the increments before the last when the run
+    /// kept only the last: [`IncrementalOptions::history`](super::IncrementalOptions::history)).
     pub contact_results: Vec<Vec<ContactRecord>>,
-    /// Per increment, [ux, uy, uz, rx, ry, rz] of every node.
+    /// Per increment, every contact's state (kept for every increment).
+    pub contact_states: Vec<Vec<ContactState>>,
+    /// Per increment, [ux, uy, uz, rx, ry, rz] of every node (empty like `contact_results`).
     pub displacements: Vec<Vec<[f64; 6]>>,
     /// Reactions at the end.
     pub reactions: Vec<Reaction>,
+}
+
+impl IncrementalSolution {
+    /// Bytes its per-increment outputs hold: every increment's displacements of every node
+    /// and record of every contact, and the increments' summaries.
+    pub fn memory_bytes(&self) -> usize {
+        let displacements: usize = self
+            .displacements
+            .iter()
+            .map(|d| d.capacity() * size_of::<[f64; 6]>())
+            .sum();
+        let records: usize = self
+            .contact_results
+            .iter()
+            .map(|r| r.capacity() * size_of::<ContactRecord>())
+            .sum();
+        let states: usize = self
+            .contact_states
+            .iter()
+            .map(|s| s.capacity() * size_of::<ContactState>())
+            .sum();
+        displacements + records + states + self.increments.capacity() * size_of::<IncrementRecord>()
+    }
 }

@@ -171,6 +171,7 @@ impl RunState {
         let keep = |n: usize| n.saturating_sub(1);
         out.increments.drain(..keep(out.increments.len()));
         out.contact_results.drain(..keep(out.contact_results.len()));
+        out.contact_states.drain(..keep(out.contact_states.len()));
         out.displacements.drain(..keep(out.displacements.len()));
     }
 }
