@@ -48,6 +48,11 @@ impl StickSlip<'_, '_, '_> {
             && n_free > 0
             && (factors.reference.is_none() || factors.refresh_reference);
         let backends = &mut factors.backends;
+        // A direct symmetric solver beside the reference works on the reference's analysis
+        // (the pattern is the same): no second ordering, symbolic factor or lower pattern.
+        let beside_reference = (!nonsymmetric && !make_reference && backends.symmetric.is_none())
+            .then(|| backends.reference.as_ref().and_then(|r| r.share()))
+            .flatten();
         let (slot, kind) = if nonsymmetric {
             (&mut backends.general, SolverKind::FaerLu)
         } else if make_reference {
@@ -57,7 +62,11 @@ impl StickSlip<'_, '_, '_> {
         };
         if slot.is_none() && !nonsymmetric {
             // The cell's shared analysis, when there is one.
-            *slot = setup.shared.as_ref().and_then(|s| s.solver());
+            *slot = setup
+                .shared
+                .as_ref()
+                .and_then(|s| s.solver())
+                .or(beside_reference);
         }
         if slot.is_none() {
             let mut s = SolverConfig {
