@@ -823,7 +823,7 @@ pub fn bench_cell(
     });
     let mild_curve = curves[1].take().transpose()?;
     let curve = curves[0].take().transpose()?;
-    let factor_bytes = 8 * backend_results[0].nnz_l.unwrap_or(0);
+    let factor_bytes = 8 * backend_results.first().and_then(|b| b.nnz_l).unwrap_or(0);
     Ok(CellBench {
         cell: cell.to_string(),
         fibers: generated.report.deposited,

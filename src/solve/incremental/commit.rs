@@ -164,7 +164,7 @@ impl StickSlip<'_, '_, '_> {
             equilibrium_residual,
             energy: balance,
         });
-        if !setup.opts.history.keeps_all(true) {
+        if !setup.opts.history.keeps_all() {
             // Only the last increment keeps its full outputs: free the one before.
             if let (Some(r), Some(d)) =
                 (out.contact_results.last_mut(), out.displacements.last_mut())

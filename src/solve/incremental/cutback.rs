@@ -80,10 +80,7 @@ impl StickSlip<'_, '_, '_> {
         self.q = s.q;
         self.energy = s.energy;
         self.out.reactions = s.reactions;
-        self.out.increments.truncate(s.records);
-        self.out.contact_results.truncate(s.records);
-        self.out.contact_states.truncate(s.records);
-        self.out.displacements.truncate(s.records);
+        self.out.truncate(s.records);
     }
 
     /// Merges the records of the two halves (and the `attempt` on the whole) into the second
@@ -94,10 +91,7 @@ impl StickSlip<'_, '_, '_> {
         if n < 2 {
             return;
         }
-        let first = out.increments.remove(n - 2);
-        out.contact_results.remove(n - 2);
-        out.contact_states.remove(n - 2);
-        out.displacements.remove(n - 2);
+        let first = out.remove(n - 2);
         if let Some(last) = out.increments.last_mut() {
             merge_halves(last, &first, attempt.as_ref());
         }

@@ -159,13 +159,10 @@ pub enum History {
 }
 
 impl History {
-    /// Whether a run keeps every increment, `Auto` meaning `all_by_default`.
-    pub fn keeps_all(self, all_by_default: bool) -> bool {
-        match self {
-            History::Auto => all_by_default,
-            History::All => true,
-            History::Last => false,
-        }
+    /// Whether a run keeps every increment: all but `Last` (a curve turns `Auto` into `Last`
+    /// before its run starts).
+    pub fn keeps_all(self) -> bool {
+        self != History::Last
     }
 }
 

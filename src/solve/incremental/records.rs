@@ -156,6 +156,31 @@ pub struct IncrementalSolution {
 }
 
 impl IncrementalSolution {
+    /// Keeps the first `n` increments' records (a cutback going back).
+    pub(super) fn truncate(&mut self, n: usize) {
+        self.increments.truncate(n);
+        self.contact_results.truncate(n);
+        self.contact_states.truncate(n);
+        self.displacements.truncate(n);
+    }
+
+    /// Removes increment `k`'s records and returns its summary.
+    pub(super) fn remove(&mut self, k: usize) -> IncrementRecord {
+        self.contact_results.remove(k);
+        self.contact_states.remove(k);
+        self.displacements.remove(k);
+        self.increments.remove(k)
+    }
+
+    /// Drops the records of every increment but the last.
+    pub(super) fn keep_last(&mut self) {
+        let earlier = self.increments.len().saturating_sub(1);
+        self.increments.drain(..earlier);
+        self.contact_results.drain(..earlier);
+        self.contact_states.drain(..earlier);
+        self.displacements.drain(..earlier);
+    }
+
     /// Bytes its per-increment outputs hold: every increment's displacements of every node
     /// and record of every contact, and the increments' summaries.
     pub fn memory_bytes(&self) -> usize {

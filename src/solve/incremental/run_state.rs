@@ -167,12 +167,7 @@ impl RunState {
 
     /// Drops every record but the last increment's (a cell state lives for many increments).
     fn keep_last_record(&mut self) {
-        let out = &mut self.out;
-        let keep = |n: usize| n.saturating_sub(1);
-        out.increments.drain(..keep(out.increments.len()));
-        out.contact_results.drain(..keep(out.contact_results.len()));
-        out.contact_states.drain(..keep(out.contact_states.len()));
-        out.displacements.drain(..keep(out.displacements.len()));
+        self.out.keep_last();
     }
 }
 
