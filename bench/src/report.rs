@@ -19,7 +19,12 @@ fn ms(s: f64) -> String {
 }
 
 fn mb(bytes: usize) -> String {
-    format!("{:.0} MB", bytes as f64 / 1e6)
+    let mb = bytes as f64 / 1e6;
+    if mb >= 10.0 {
+        format!("{mb:.0} MB")
+    } else {
+        format!("{mb:.2} MB")
+    }
 }
 
 fn per_second(v: f64) -> String {
