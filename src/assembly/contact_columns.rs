@@ -325,7 +325,7 @@ fn node_block<const M: usize>(b: &[f64], r: &[f64], sr: &[[f64; 6]; 6]) -> [[f64
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::generate::{nonwoven, FiberAmount, LengthDistribution, NonWoven};
     use crate::homogenize::{ContactStiffness, PeriodicSystem, PeriodicValues};
@@ -340,8 +340,9 @@ mod tests {
         }
     }
 
-    /// A periodic non-woven cell of 60 fibers, with contacts across its boundary.
-    fn system() -> PeriodicSystem {
+    /// A periodic non-woven cell of 60 fibers, with contacts across its boundary (also the
+    /// stick/slip matrix values' test cell).
+    pub(crate) fn system() -> PeriodicSystem {
         let description = nonwoven(&NonWoven {
             size: [3e-3, 3e-3],
             amount: FiberAmount::Count { fibers: 60 },

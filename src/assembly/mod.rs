@@ -14,3 +14,7 @@ pub use element_blocks::{ElementBlocks, InternalForces};
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
 pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};
 pub(crate) use shared::{prefetch, SharedMut};
+
+/// A small periodic cell with contacts, for the unit tests of the assembled values.
+#[cfg(test)]
+pub(crate) use contact_columns::tests::system as test_system;

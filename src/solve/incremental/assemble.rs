@@ -47,7 +47,7 @@ impl StickSlip<'_, '_, '_> {
             .as_deref()
             .map(|reference| contact_changes(setup, contacts, reference, inc));
         if changes.is_none() {
-            matrix.changed_since_reference = None;
+            matrix.drop_reference();
             matrix.values.copy_from_slice(&setup.k_elastic);
             assembled_values(setup, contacts, &mut matrix.values);
         }

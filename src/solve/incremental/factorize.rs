@@ -13,7 +13,6 @@ use crate::solve::low_rank::Reference;
 use crate::solve::{SolverConfig, SolverKind};
 use crate::Error;
 use fibercell_solver::{solve_checked, SolveReport, SolverError};
-use std::sync::Arc;
 
 impl StickSlip<'_, '_, '_> {
     /// Factorizes `system` if needed and solves it: the solution and its report (none without
@@ -118,11 +117,6 @@ impl StickSlip<'_, '_, '_> {
                 factors.refresh_reference = false;
                 factors.reference = Some(reference_blocks(setup, contacts));
                 refactorized = true;
-                matrix.reference = match shared {
-                    Some(s) => s.values(),
-                    None => Arc::new(matrix.values.clone()),
-                };
-                matrix.changed_since_reference = Some(Vec::new());
                 factors.low_rank.reset();
                 factors.affine.clear();
             }
@@ -148,6 +142,7 @@ impl StickSlip<'_, '_, '_> {
         }
         let (x, r) = solve_checked(solver.as_mut(), a, &system.rhs, 1).map_err(locate)?;
         if refactorized {
+            matrix.set_reference();
             // The reference's own load: A₀⁻¹ b₀ of this increment.
             factors.reference_solution = Some(Reference::Full(x.clone()));
             factors.reference_solve = Some(ReferenceSolve {

@@ -69,11 +69,6 @@ impl SharedReference {
         self.values[..] == *values
     }
 
-    /// The matrix values at rest (shared).
-    pub(super) fn values(&self) -> Arc<Vec<f64>> {
-        Arc::clone(&self.values)
-    }
-
     /// What a factorization took when the cell was built (s).
     pub(super) fn factorize_seconds(&self) -> f64 {
         self.factorize_seconds
@@ -92,7 +87,6 @@ impl SharedReference {
         factors.cost.factorize = Some(self.factorize_seconds);
         factors.low_rank.reset();
         factors.affine.clear();
-        matrix.reference = self.values();
-        matrix.changed_since_reference = None;
+        matrix.adopt_reference(&self.values);
     }
 }
