@@ -40,9 +40,79 @@ impl LowerTriangle {
         }
     }
 
+    /// The lower triangle of P A Pᵀ (`inv[old] = new`), rows sorted within each column, its
+    /// entries still read from A: a factorization in that order then needs no permuted copy.
+    pub fn permuted(&self, inv: &[usize]) -> Self {
+        let n = self.col_ptr.len() - 1;
+        let column_of = |i: usize, j: usize| inv[i].min(inv[j]);
+        let mut col_ptr = vec![0usize; n + 1];
+        for j in 0..n {
+            for &i in &self.row_idx[self.col_ptr[j]..self.col_ptr[j + 1]] {
+                col_ptr[column_of(i, j) + 1] += 1;
+            }
+        }
+        for j in 0..n {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        let mut next = col_ptr[..n].to_vec();
+        let mut entries = vec![(0usize, 0usize); self.nnz()];
+        for j in 0..n {
+            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let i = self.row_idx[k];
+                let c = column_of(i, j);
+                entries[next[c]] = (inv[i].max(inv[j]), self.src[k]);
+                next[c] += 1;
+            }
+        }
+        for j in 0..n {
+            entries[col_ptr[j]..col_ptr[j + 1]].sort_unstable();
+        }
+        let (row_idx, src) = entries.into_iter().unzip();
+        LowerTriangle {
+            col_ptr,
+            row_idx,
+            src,
+        }
+    }
+
     /// Stored entries.
     pub fn nnz(&self) -> usize {
         self.row_idx.len()
+    }
+
+    /// [`LowerTriangle::scaled_values`] for a triangle made by [`LowerTriangle::permuted`]
+    /// with the inverse of `fwd` (`fwd[new] = old`): the lower values of P S A S Pᵀ, `scale` in
+    /// A's order. An error names A's column.
+    pub fn scaled_permuted_values(
+        &self,
+        a: CscRef<'_>,
+        fwd: &[usize],
+        scale: &mut [f64],
+        values: &mut [f64],
+    ) -> Result<(), SolverError> {
+        let n = self.col_ptr.len() - 1;
+        for j in 0..n {
+            let first = self.col_ptr[j];
+            let ajj = if first < self.col_ptr[j + 1] && self.row_idx[first] == j {
+                a.values()[self.src[first]]
+            } else {
+                0.0
+            };
+            if !(ajj > 0.0) {
+                return Err(SolverError::NotPositiveDefinite {
+                    column: fwd[j],
+                    pivot: ajj,
+                });
+            }
+            scale[fwd[j]] = 1.0 / ajj.sqrt();
+        }
+        for j in 0..n {
+            let sj = scale[fwd[j]];
+            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                values[k] = a.values()[self.src[k]] * scale[fwd[self.row_idx[k]]] * sj;
+            }
+        }
+        Ok(())
     }
 
     /// Writes `scale[j] = 1/√a_jj` and the lower values of S A S. A diagonal entry that is
@@ -105,6 +175,18 @@ mod tests {
         l.scaled_values(a.as_ref(), &mut s, &mut v).unwrap();
         assert_eq!(s, vec![0.5, 1.0 / 3.0, 0.25]);
         assert_eq!(v, vec![1.0, 2.0 / 6.0, 1.0, 3.0 / 12.0, 1.0]);
+        // Permuted by fwd = [2, 0, 1]: the lower triangle of P S A S Pᵀ, rows sorted.
+        let (fwd, inv) = ([2, 0, 1], [1, 2, 0]);
+        let p = l.permuted(&inv);
+        let mut pv = vec![0.0; p.nnz()];
+        let mut ps = vec![0.0; 3];
+        p.scaled_permuted_values(a.as_ref(), &fwd, &mut ps, &mut pv)
+            .unwrap();
+        assert_eq!(ps, s);
+        assert_eq!(p.col_ptr, vec![0, 2, 4, 5]);
+        assert_eq!(p.row_idx, vec![0, 2, 1, 2, 2]);
+        // (new 0 = old 2): a22 = 1, a21 → (new 2, new 0); (new 1 = old 0): a00, a10 → (2, 1).
+        assert_eq!(pv, vec![1.0, 3.0 / 12.0, 1.0, 2.0 / 6.0, 1.0]);
         let bad = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (1, 0, 1.0), (0, 1, 1.0)]).unwrap();
         let l = LowerTriangle::of(bad.as_ref());
         let e = l

@@ -15,8 +15,8 @@ use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
+    factorize_symbolic_cholesky, supernodal, CholeskySymbolicParams, LdltRef, LltRef,
+    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
@@ -58,6 +58,8 @@ pub struct FaerCholesky {
 struct Analysis {
     n: usize,
     fingerprint: PatternFingerprint,
+    /// A's lower triangle: in the factor's order for a supernodal factor (factorized as it
+    /// is), else in A's (faer permutes it).
     lower: LowerTriangle,
     /// The permutation faer factorizes with (`fwd[new] = old`).
     perm: Permutation,
@@ -283,6 +285,11 @@ impl LinearSolver for FaerCholesky {
             Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
             None => ((0..n).collect(), (0..n).collect()),
         };
+        let lower_tri = if is_simplicial(&symbolic) {
+            lower_tri
+        } else {
+            lower_tri.permuted(&factor_inv)
+        };
         self.analysis = Some(Arc::new(Analysis {
             n,
             fingerprint: a.fingerprint(),
@@ -318,11 +325,25 @@ impl LinearSolver for FaerCholesky {
         let mut ws = match self.workspace.take() {
             Some(ws) => ws,
             None => {
-                let req = match self.variant {
-                    CholeskyVariant::Llt => an
+                let req = match (self.variant, an.symbolic.raw()) {
+                    (CholeskyVariant::Llt, SymbolicCholeskyRaw::Supernodal(sn)) => {
+                        supernodal::factorize_supernodal_numeric_llt_scratch::<usize, f64>(
+                            sn,
+                            self.par,
+                            Spec::default(),
+                        )
+                    }
+                    (CholeskyVariant::Ldlt, SymbolicCholeskyRaw::Supernodal(sn)) => {
+                        supernodal::factorize_supernodal_numeric_ldlt_scratch::<usize, f64>(
+                            sn,
+                            self.par,
+                            Spec::default(),
+                        )
+                    }
+                    (CholeskyVariant::Llt, _) => an
                         .symbolic
                         .factorize_numeric_llt_scratch::<f64>(self.par, Spec::default()),
-                    CholeskyVariant::Ldlt => an
+                    (CholeskyVariant::Ldlt, _) => an
                         .symbolic
                         .factorize_numeric_ldlt_scratch::<f64>(self.par, Spec::default()),
                 };
@@ -332,8 +353,21 @@ impl LinearSolver for FaerCholesky {
                 }
             }
         };
-        an.lower
-            .scaled_values(a, &mut f.scale, &mut ws.lower_values)?;
+        let supernodal = match an.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => Some(sn),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        };
+        if supernodal.is_some() {
+            an.lower.scaled_permuted_values(
+                a,
+                &an.factor_fwd,
+                &mut f.scale,
+                &mut ws.lower_values,
+            )?;
+        } else {
+            an.lower
+                .scaled_values(a, &mut f.scale, &mut ws.lower_values)?;
+        }
         let lower = SparseColMatRef::new(
             SymbolicSparseColMatRef::new_checked(n, n, &an.lower.col_ptr, None, &an.lower.row_idx),
             &ws.lower_values,
@@ -347,31 +381,63 @@ impl LinearSolver for FaerCholesky {
             };
             an.perm.fwd[k.min(n.saturating_sub(1))]
         };
+        let stack = MemStack::new(&mut ws.scratch);
         match self.variant {
             CholeskyVariant::Llt => {
-                let r = sym.factorize_numeric_llt(
-                    &mut f.l_values,
-                    lower,
-                    Side::Lower,
-                    LltRegularization::default(),
-                    self.par,
-                    MemStack::new(&mut ws.scratch),
-                    Spec::default(),
-                );
+                let reg = LltRegularization::default();
+                let r = match supernodal {
+                    // In the factor's order already: no permuted copy of A.
+                    Some(sn) => supernodal::factorize_supernodal_numeric_llt(
+                        &mut f.l_values,
+                        lower,
+                        reg,
+                        sn,
+                        self.par,
+                        stack,
+                        Spec::default(),
+                    )
+                    .map(|_| ()),
+                    None => sym
+                        .factorize_numeric_llt(
+                            &mut f.l_values,
+                            lower,
+                            Side::Lower,
+                            reg,
+                            self.par,
+                            stack,
+                            Spec::default(),
+                        )
+                        .map(|_| ()),
+                };
                 if let Err(LltError::NonPositivePivot { index }) = r {
                     return Err(pivot_error(first_pivot_index(index), 0.0));
                 }
             }
             CholeskyVariant::Ldlt => {
-                let r = sym.factorize_numeric_ldlt(
-                    &mut f.l_values,
-                    lower,
-                    Side::Lower,
-                    LdltRegularization::default(),
-                    self.par,
-                    MemStack::new(&mut ws.scratch),
-                    Spec::default(),
-                );
+                let reg = LdltRegularization::default();
+                let r = match supernodal {
+                    Some(sn) => supernodal::factorize_supernodal_numeric_ldlt(
+                        &mut f.l_values,
+                        lower,
+                        reg,
+                        sn,
+                        self.par,
+                        stack,
+                        Spec::default(),
+                    )
+                    .map(|_| ()),
+                    None => sym
+                        .factorize_numeric_ldlt(
+                            &mut f.l_values,
+                            lower,
+                            Side::Lower,
+                            reg,
+                            self.par,
+                            stack,
+                            Spec::default(),
+                        )
+                        .map(|_| ()),
+                };
                 if let Err(e) = r {
                     let faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } = e;
                     return Err(pivot_error(first_pivot_index(index), 0.0));
