@@ -78,6 +78,8 @@ impl Pattern {
         if row_idx.len() >= NO_SLOT as usize {
             return Err(PatternTooLargeError(row_idx.len()));
         }
+        // Grown by doubling: up to twice its length (L: 268 MB held for 232 MB of entries).
+        row_idx.shrink_to_fit();
         let reduced_of = |g: usize| (red[g] != usize::MAX).then_some(red[g]);
         let mut block_offsets = vec![0];
         let mut slots =

@@ -48,7 +48,7 @@ impl StickSlip<'_, '_, '_> {
             .map(|reference| contact_changes(setup, contacts, reference, inc));
         if changes.is_none() {
             matrix.drop_reference();
-            matrix.values.copy_from_slice(&setup.k_elastic);
+            setup.elastic_values(&mut matrix.values)?;
             assembled_values(setup, contacts, &mut matrix.values);
         }
         let mut rhs = path.rhs(inc.alpha);

@@ -40,7 +40,8 @@ impl RunState {
             .collect();
         let nonsymmetric = blocks.iter().any(|d| *d != d.transpose());
         let (pairs, disc) = (&setup.pairs, &setup.disc);
-        let mut values = setup.k_elastic.clone();
+        let mut values = Vec::new();
+        setup.elastic_values(&mut values)?;
         setup
             .contact_columns
             .add(pairs, &setup.pattern, disc, &mut values, None, |i| {

@@ -24,10 +24,15 @@ pub(super) struct MatrixValues {
 }
 
 impl MatrixValues {
-    /// The elastic values `k_elastic` and no reference yet.
-    pub fn new(k_elastic: &[f64]) -> Self {
+    /// No values (the first assembly writes them) and no reference yet.
+    pub fn empty() -> Self {
+        Self::new(Vec::new())
+    }
+
+    /// The values `values` and no reference yet.
+    pub fn new(values: Vec<f64>) -> Self {
         MatrixValues {
-            values: k_elastic.to_vec(),
+            values,
             saved_at: Vec::new(),
             saved: Vec::new(),
             changed_since_reference: None,
@@ -149,7 +154,7 @@ mod tests {
         let (pattern, pairs) = (&sys.pattern, &sys.contacts);
         assert!(pairs.len() > 20, "{} contacts", pairs.len());
         let reference: Vec<f64> = (0..pattern.nnz()).map(|k| 1.0 + k as f64 * 1e-3).collect();
-        let mut m = MatrixValues::new(&reference);
+        let mut m = MatrixValues::new(reference.clone());
         m.set_reference();
         let sets: [Vec<ContactChange>; 4] = [
             (0..10).map(|c| change(c, 1.0)).collect(),

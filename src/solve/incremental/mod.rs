@@ -211,7 +211,7 @@ impl<'s, 'a, 'h> StickSlip<'s, 'a, 'h> {
             path: LoadPath::new(setup),
             factors: Factors::new(setup.n_free(), setup.pairs.len()),
             on_all_stick,
-            matrix: MatrixValues::new(&setup.k_elastic),
+            matrix: MatrixValues::empty(),
             kept_loads: None,
             q: vec![0.0; n],
             energy: EnergyHistory {

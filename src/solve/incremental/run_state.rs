@@ -147,7 +147,7 @@ impl RunState {
         RunState {
             contacts: self.contacts.clone(),
             factors: self.factors.emptied(),
-            matrix: MatrixValues::new(&[]),
+            matrix: MatrixValues::empty(),
             kept_loads: self.kept_loads.clone(),
             q: self.q.clone(),
             energy: self.energy.clone(),
@@ -162,7 +162,7 @@ impl RunState {
     /// alone stays, and the next increment factorizes anew.
     pub fn release_caches(&mut self) {
         self.factors = self.factors.emptied();
-        self.matrix = MatrixValues::new(&[]);
+        self.matrix = MatrixValues::empty();
     }
 
     /// Drops every record but the last increment's (a cell state lives for many increments).
@@ -187,9 +187,6 @@ impl<'s, 'a> StickSlip<'s, 'a, '_> {
             ..
         } = run;
         let mut factors = factors;
-        if matrix.values.len() != setup.k_elastic.len() {
-            matrix = MatrixValues::new(&setup.k_elastic);
-        }
         // A state past rest without caches solves on the cell's rest factorization (a state
         // at rest meets it in its first factorization, bit for bit as a run).
         if let (None, true, Some(shared)) = (&factors.reference, step > 0, &setup.shared) {

@@ -37,8 +37,11 @@ pub(crate) struct Setup<'a> {
     pub elastic: ElementBlocks,
     /// Elements ∪ every candidate contact block, on the free DOFs.
     pub pattern: Pattern,
-    /// K of the elements in the pattern's slots.
-    pub k_elastic: Vec<f64>,
+    /// K of the elements in the pattern's slots, kept where it is read repeatedly: without
+    /// low-rank solves (every iteration assembles anew) and in a stateful cell (tangents).
+    /// A run with low-rank solves reads it once, before its first reference factorization,
+    /// and fills it again then instead ([`Setup::elastic_values`]): 0.23 GB on L.
+    k_elastic: Option<Vec<f64>>,
     /// Contacts by color: no two of a color share a generalized node (the driver, which has no
     /// rows, aside), so a color's contacts add their loads in parallel.
     pub contact_colors: Vec<Vec<usize>>,
@@ -104,8 +107,6 @@ impl<'a> Setup<'a> {
             &block_refs,
             model.elements().len(),
         )?;
-        let mut k_elastic = vec![0.0; pattern.nnz()];
-        elastic.fill(&model, &pattern, &mut k_elastic, opts.solve.fill)?;
         let contact_colors = color_blocks(
             disc.n_gnodes(),
             pairs.iter().map(|p| &p.jump.nodes[..]),
@@ -129,6 +130,13 @@ impl<'a> Setup<'a> {
             && solver_config
                 .build()
                 .is_ok_and(|s| !s.capabilities().iterative);
+        let k_elastic = if low_rank_possible {
+            None
+        } else {
+            let mut k = vec![0.0; pattern.nnz()];
+            elastic.fill(&model, &pattern, &mut k, opts.solve.fill)?;
+            Some(k)
+        };
         let (length_tol, direction_tol) = (
             1e-12 * model.size(),
             SLIP_DIRECTION_TOLERANCE * model.size(),
@@ -163,7 +171,26 @@ impl<'a> Setup<'a> {
     /// Factorizes the rest state once for every state run on this setup to share (see
     /// [`SharedReference`]).
     pub fn share_rest_factorization(&mut self) -> Result<(), Error> {
+        if self.k_elastic.is_none() {
+            // A cell's states read them for every tangent.
+            let mut k = Vec::new();
+            self.elastic_values(&mut k)?;
+            self.k_elastic = Some(k);
+        }
         self.shared = SharedReference::build(self)?;
+        Ok(())
+    }
+
+    /// Writes K of the elements into `values` (resized to the pattern's slots): the kept
+    /// copy, or filled anew.
+    pub fn elastic_values(&self, values: &mut Vec<f64>) -> Result<(), Error> {
+        values.resize(self.pattern.nnz(), 0.0);
+        match &self.k_elastic {
+            Some(k) => values.copy_from_slice(k),
+            None => self
+                .elastic
+                .fill(&self.model, &self.pattern, values, self.opts.solve.fill)?,
+        }
         Ok(())
     }
 

@@ -36,7 +36,8 @@ impl SharedReference {
             return Ok(None);
         }
         let rest = RunState::start(setup);
-        let mut values = setup.k_elastic.clone();
+        let mut values = Vec::new();
+        setup.elastic_values(&mut values)?;
         assembled_values(setup, &rest.contacts, &mut values);
         let a = setup.pattern.matrix(&values)?;
         let mut solver = SolverConfig {
