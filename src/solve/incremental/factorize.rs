@@ -7,6 +7,7 @@ use super::contact_states::ContactStates;
 use super::driver_couplings::DriverCouplings;
 use super::factors::{ReferenceBlock, ReferenceSolve};
 use super::increment::Increment;
+use super::options::MAX_BESIDE_FACTOR_BYTES;
 use super::StickSlip;
 use crate::contact::Friction;
 use crate::solve::low_rank::Reference;
@@ -41,12 +42,28 @@ impl StickSlip<'_, '_, '_> {
         let a = setup.pattern.matrix(&matrix.values)?;
         let nonsymmetric = system.nonsymmetric;
         // The first symmetric factorization, or the next after the correction outgrew its
-        // columns or its accuracy, becomes the reference (in its own solver).
+        // columns or its accuracy, becomes the reference (in its own solver); so does any
+        // other when a second factor beside the reference is not worth its memory.
+        let beside_allowed = factors.low_rank.len() > 0
+            && factors
+                .factor_bytes
+                .is_none_or(|b| b <= MAX_BESIDE_FACTOR_BYTES);
         let make_reference = !nonsymmetric
             && setup.low_rank_possible
             && n_free > 0
-            && (factors.reference.is_none() || factors.refresh_reference);
+            && (factors.reference.is_none() || factors.refresh_reference || !beside_allowed);
         let backends = &mut factors.backends;
+        if make_reference {
+            // The old reference's correction and a factor beside it go before the new
+            // factorization allocates.
+            backends.symmetric = None;
+            if factors.factorized.as_ref().is_some_and(|key| !key.0) {
+                factors.factorized = None;
+            }
+            factors.low_rank.reset();
+            factors.affine.clear();
+            factors.reference_solution = None;
+        }
         // A direct symmetric solver beside the reference works on the reference's analysis
         // (the pattern is the same): no second ordering, symbolic factor or lower pattern.
         let beside_reference = (!nonsymmetric && !make_reference && backends.symmetric.is_none())
@@ -73,7 +90,10 @@ impl StickSlip<'_, '_, '_> {
                 ..setup.solver_config.clone()
             }
             .build()?;
-            s.analyze(a).map_err(locate)?;
+            let info = s.analyze(a).map_err(locate)?;
+            if !nonsymmetric {
+                factors.factor_bytes = info.nnz_factor.map(|nnz| 8 * nnz);
+            }
             *slot = Some(s);
         }
         let solver = slot
@@ -117,8 +137,6 @@ impl StickSlip<'_, '_, '_> {
                 factors.refresh_reference = false;
                 factors.reference = Some(reference_blocks(setup, contacts));
                 refactorized = true;
-                factors.low_rank.reset();
-                factors.affine.clear();
             }
             // The initial states are all-stick unless frictionless (sliding).
             let friction = setup.friction();

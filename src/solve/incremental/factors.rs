@@ -93,6 +93,8 @@ pub(super) struct Factors {
     pub affine: AffineReferences,
     /// The reference's own direct solve, once factorized.
     pub reference_solve: Option<ReferenceSolve>,
+    /// The bytes of a symmetric factor's values, from its analysis (None: not analyzed here).
+    pub factor_bytes: Option<usize>,
 }
 
 /// The direct solve that factorized the reference.
@@ -120,6 +122,7 @@ impl Factors {
             low_rank: LowRankCorrection::new(n_free, contacts),
             affine: AffineReferences::default(),
             reference_solve: None,
+            factor_bytes: None,
         }
     }
 

@@ -249,6 +249,14 @@ pub(super) const LOW_RANK_MATCH: f64 = 10.0;
 /// default: S, their dense products, then takes 8 bytes × this squared (512 MB).
 pub const MAX_LOW_RANK_COLUMNS: usize = 8192;
 
+/// A direct symmetric factorization is kept beside the reference A₀ (whose low-rank columns
+/// later iterations with fewer changes reuse) only while a factor has at most this many bytes;
+/// a larger one becomes the new reference instead, so that a large cell's run holds one
+/// factor: on the L non-woven a factor is 0.8 GB, and from the crossover on (increment 79 of
+/// its e11 curve) the reference's 7,400 columns served no further solve while the factor
+/// beside them took the run from 4.5 to 6.1 GB. The M non-woven's factor is 91 MB.
+pub(super) const MAX_BESIDE_FACTOR_BYTES: usize = 256 << 20;
+
 /// Correction steps x += W (b − A x) after a low-rank solve W ≈ A⁻¹ before it falls back to a
 /// factorization (the correction subtracts stick springs far stiffer than the fibers, which
 /// costs digits that one or two steps restore).
