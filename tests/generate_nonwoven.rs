@@ -215,8 +215,28 @@ fn presets_reach_their_contact_counts() {
     let s = network_stats(&model(&nonwoven_preset("S", 1).unwrap())).unwrap();
     assert_eq!(s.fibers, 200);
     assert!(s.contacts >= 1000, "{}", s.contacts);
-    let e = nonwoven_preset("XL", 1).unwrap_err();
+    let e = nonwoven_preset("XXL", 1).unwrap_err();
     assert!(e.to_string().contains("unknown cell size"), "{e}");
+}
+
+/// Every preset has S's areal density of fibers (within 1 %: M's side is rounded to 0.1 mm)
+/// and L's elements or coarser; XL has four times L's fibers on twice its side.
+#[test]
+fn presets_share_one_areal_density() {
+    let density = |p: &NonWoven| {
+        let FiberAmount::Count { fibers } = p.amount else {
+            panic!("presets give a fiber count")
+        };
+        (fibers as f64 / (p.size[0] * p.size[1]), fibers)
+    };
+    let [s, m, l, xl] = ["S", "M", "L", "xl"].map(|n| nonwoven_preset(n, 1).unwrap());
+    let (rho, _) = density(&s);
+    for p in [&m, &l, &xl] {
+        assert!((density(p).0 / rho - 1.0).abs() < 0.01, "{:?}", p.size);
+    }
+    assert_eq!(density(&xl).1, 4 * density(&l).1);
+    assert_eq!(xl.size[0], 2.0 * l.size[0]);
+    assert_eq!(xl.element_length, l.element_length);
 }
 
 #[test]

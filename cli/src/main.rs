@@ -49,7 +49,7 @@ impl SolverArgs {
 /// The random cells of `ensemble` and `rve-study`: a generator and the seeds of its realizations.
 #[derive(clap::Args, Clone, Debug)]
 struct GeneratorArgs {
-    /// Non-woven preset (S, M or L) as the generator.
+    /// Non-woven preset (S, M, L or XL) as the generator.
     #[arg(long, conflicts_with = "params", required_unless_present = "params")]
     preset: Option<String>,
     /// Generator parameter file (`family = "nonwoven"` etc., as `fixtures/cells/*.params.toml`).
@@ -74,7 +74,7 @@ impl GeneratorArgs {
             )),
             (None, Some(path)) => Ok((io::read_cell_params(path)?, path.display().to_string())),
             (None, None) => Err(Error::InvalidOption(
-                "give the generator: --preset S|M|L or --params FILE".into(),
+                "give the generator: --preset S|M|L|XL or --params FILE".into(),
             )),
         }
     }
@@ -367,7 +367,7 @@ enum GenerateKind {
         /// below override it.
         #[arg(long, conflicts_with = "preset")]
         params: Option<PathBuf>,
-        /// Start from a benchmark cell: S, M or L (see docs/generators.md).
+        /// Start from a benchmark cell: S, M, L or XL (see docs/generators.md).
         #[arg(long)]
         preset: Option<String>,
         /// Cell periods Lx,Ly (m).

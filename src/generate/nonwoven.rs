@@ -153,15 +153,16 @@ fn default_bond_strength() -> f64 {
 /// The benchmark cells of the README and `fibercell bench`, all at one areal density (5.6
 /// fibers of 2.5 mm per mm², radius 10 µm, isotropic): S (200 fibers, 6 mm cell), M (1,000
 /// fibers, 13.4 mm, more than 5,000 contacts), L (5,000 fibers, 30 mm, more than 30,000
-/// contacts, about 10⁶ DOFs).
+/// contacts, about 10⁶ DOFs), XL (20,000 fibers, 60 mm, L's elements: about 4·10⁶ DOFs).
 pub fn nonwoven_preset(name: &str, seed: u64) -> Result<NonWoven, Error> {
     let (fibers, side, h) = match name.to_ascii_uppercase().as_str() {
         "S" => (200, 6e-3, 2.5e-4),
         "M" => (1000, 13.4e-3, 2.5e-4),
         "L" => (5000, 30e-3, 1.2e-4),
+        "XL" => (20000, 60e-3, 1.2e-4),
         _ => {
             return Err(invalid(format!(
-                "unknown cell size \"{name}\" (use S, M or L)"
+                "unknown cell size \"{name}\" (use S, M, L or XL)"
             )))
         }
     };
