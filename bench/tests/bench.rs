@@ -121,12 +121,12 @@ fn the_small_cell_runs_every_stage() {
 #[test]
 fn unknown_cells_and_bad_options_are_typed_errors() {
     let bad_cell = BenchOptions {
-        cells: vec!["XL".into()],
+        cells: vec!["XXL".into()],
         curve_steps: 0,
         ..BenchOptions::default()
     };
     let err = run_bench(&bad_cell, &mut |_| {}).unwrap_err();
-    assert!(err.to_string().contains("XL"), "{err}");
+    assert!(err.to_string().contains("XXL"), "{err}");
     let no_repeats = BenchOptions {
         repeats: 0,
         ..BenchOptions::default()

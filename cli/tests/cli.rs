@@ -423,7 +423,7 @@ fn generate_nonwoven_writes_a_cell_that_stats_reads() {
             "unknown orientation",
         ),
         (
-            vec!["generate", "nonwoven", "--preset", "XL", "-o", "x.toml"],
+            vec!["generate", "nonwoven", "--preset", "XXL", "-o", "x.toml"],
             "unknown cell size",
         ),
         (
