@@ -90,29 +90,7 @@ impl LowerTriangle {
         scale: &mut [f64],
         values: &mut [f64],
     ) -> Result<(), SolverError> {
-        let n = self.col_ptr.len() - 1;
-        for j in 0..n {
-            let first = self.col_ptr[j];
-            let ajj = if first < self.col_ptr[j + 1] && self.row_idx[first] == j {
-                a.values()[self.src[first]]
-            } else {
-                0.0
-            };
-            if !(ajj > 0.0) {
-                return Err(SolverError::NotPositiveDefinite {
-                    column: fwd[j],
-                    pivot: ajj,
-                });
-            }
-            scale[fwd[j]] = 1.0 / ajj.sqrt();
-        }
-        for j in 0..n {
-            let sj = scale[fwd[j]];
-            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
-                values[k] = a.values()[self.src[k]] * scale[fwd[self.row_idx[k]]] * sj;
-            }
-        }
-        Ok(())
+        self.scaled_in_order(a, |j| fwd[j], scale, values)
     }
 
     /// Writes `scale[j] = 1/√a_jj` and the lower values of S A S. A diagonal entry that is
@@ -123,8 +101,19 @@ impl LowerTriangle {
         scale: &mut [f64],
         values: &mut [f64],
     ) -> Result<(), SolverError> {
+        self.scaled_in_order(a, |j| j, scale, values)
+    }
+
+    /// The scaled values of a triangle whose index `j` is A's index `old(j)`.
+    fn scaled_in_order(
+        &self,
+        a: CscRef<'_>,
+        old: impl Fn(usize) -> usize,
+        scale: &mut [f64],
+        values: &mut [f64],
+    ) -> Result<(), SolverError> {
         let n = self.col_ptr.len() - 1;
-        for (j, s) in scale.iter_mut().enumerate().take(n) {
+        for j in 0..n {
             let first = self.col_ptr[j];
             let ajj = if first < self.col_ptr[j + 1] && self.row_idx[first] == j {
                 a.values()[self.src[first]]
@@ -133,15 +122,16 @@ impl LowerTriangle {
             };
             if !(ajj > 0.0) {
                 return Err(SolverError::NotPositiveDefinite {
-                    column: j,
+                    column: old(j),
                     pivot: ajj,
                 });
             }
-            *s = 1.0 / ajj.sqrt();
+            scale[old(j)] = 1.0 / ajj.sqrt();
         }
         for j in 0..n {
+            let sj = scale[old(j)];
             for k in self.col_ptr[j]..self.col_ptr[j + 1] {
-                values[k] = a.values()[self.src[k]] * scale[self.row_idx[k]] * scale[j];
+                values[k] = a.values()[self.src[k]] * scale[old(self.row_idx[k])] * sj;
             }
         }
         Ok(())
