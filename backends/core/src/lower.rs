@@ -3,6 +3,7 @@
 //! its own diagonal entry.
 
 use crate::{CscRef, SolverError};
+use std::ops::Range;
 
 /// Pattern of the lower triangle (diagonal included) with, for each entry, its index in the
 /// full matrix's values — built once per pattern, so refills are a gather.
@@ -104,6 +105,27 @@ impl LowerTriangle {
         self.scaled_in_order(a, |j| j, scale, values)
     }
 
+    /// values = S A S for the columns `cols` (`values` holding exactly their entries), halved
+    /// over the threads down to runs of 2¹⁶ entries.
+    fn scale_columns(&self, cols: Range<usize>, scale: &[f64], a: &[f64], values: &mut [f64]) {
+        let first = self.col_ptr[cols.start];
+        if values.len() > 1 << 16 && cols.len() > 1 {
+            let mid = cols.start + cols.len() / 2;
+            let (left, right) = values.split_at_mut(self.col_ptr[mid] - first);
+            rayon::join(
+                || self.scale_columns(cols.start..mid, scale, a, left),
+                || self.scale_columns(mid..cols.end, scale, a, right),
+            );
+            return;
+        }
+        for j in cols {
+            let sj = scale[j];
+            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                values[k - first] = a[self.src[k]] * scale[self.row_idx[k]] * sj;
+            }
+        }
+    }
+
     /// The scaled values of a triangle whose index `j` is A's index `old(j)`.
     fn scaled_in_order(
         &self,
@@ -128,12 +150,9 @@ impl LowerTriangle {
             }
             scale[old(j)] = 1.0 / ajj.sqrt();
         }
-        for j in 0..n {
-            let sj = scale[old(j)];
-            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
-                values[k] = a.values()[self.src[k]] * scale[old(self.row_idx[k])] * sj;
-            }
-        }
+        // The scale in this triangle's order, so that rows index it directly.
+        let local: Vec<f64> = (0..n).map(|j| scale[old(j)]).collect();
+        self.scale_columns(0..n, &local, a.values(), values);
         Ok(())
     }
 }

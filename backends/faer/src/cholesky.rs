@@ -10,6 +10,7 @@ use crate::block_solve::{backward_in_place, forward_in_place, solve_in_place as 
 use crate::block_tree::{BlockTree, FactorView};
 use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
+use crate::supernodal_llt::{self, SupernodalPlan, TaskSizes};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
@@ -72,6 +73,8 @@ struct Analysis {
     factor_fwd: Vec<usize>,
     /// Its inverse, `inv[old] = new`.
     factor_inv: Vec<usize>,
+    /// The task plan of a supernodal LLᵀ factor (None: faer's own kernel factorizes).
+    plan: Option<SupernodalPlan>,
 }
 
 struct Factor {
@@ -286,6 +289,12 @@ impl LinearSolver for FaerCholesky {
             Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
             None => ((0..n).collect(), (0..n).collect()),
         };
+        let plan = match (self.variant, symbolic.raw()) {
+            (CholeskyVariant::Llt, SymbolicCholeskyRaw::Supernodal(sn)) => {
+                SupernodalPlan::new(sn, threads(self.par), TaskSizes::default())
+            }
+            _ => None,
+        };
         let lower_tri = if is_simplicial(&symbolic) {
             lower_tri
         } else {
@@ -301,6 +310,7 @@ impl LinearSolver for FaerCholesky {
             factor_fwd,
             factor_inv,
             symbolic,
+            plan,
         }));
         Ok(info)
     }
@@ -327,6 +337,8 @@ impl LinearSolver for FaerCholesky {
             Some(ws) => ws,
             None => {
                 let req = match (self.variant, an.symbolic.raw()) {
+                    // The task-parallel kernel keeps its own scratch.
+                    _ if an.plan.is_some() => faer::dyn_stack::StackReq::EMPTY,
                     (CholeskyVariant::Llt, SymbolicCholeskyRaw::Supernodal(sn)) => {
                         supernodal::factorize_supernodal_numeric_llt_scratch::<usize, f64>(
                             sn,
@@ -386,9 +398,17 @@ impl LinearSolver for FaerCholesky {
         match self.variant {
             CholeskyVariant::Llt => {
                 let reg = LltRegularization::default();
-                let r = match supernodal {
+                let r = match (supernodal, &an.plan) {
+                    // Independent subtrees on separate threads.
+                    (Some(sn), Some(plan)) => supernodal_llt::factorize_llt(
+                        &mut f.l_values,
+                        lower,
+                        sn,
+                        plan,
+                        threads(self.par),
+                    ),
                     // In the factor's order already: no permuted copy of A.
-                    Some(sn) => supernodal::factorize_supernodal_numeric_llt(
+                    (Some(sn), _) => supernodal::factorize_supernodal_numeric_llt(
                         &mut f.l_values,
                         lower,
                         reg,
@@ -398,7 +418,7 @@ impl LinearSolver for FaerCholesky {
                         Spec::default(),
                     )
                     .map(|_| ()),
-                    None => sym
+                    (None, _) => sym
                         .factorize_numeric_llt(
                             &mut f.l_values,
                             lower,

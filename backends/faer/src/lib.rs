@@ -40,6 +40,7 @@ mod permute;
 mod pivots;
 mod prefetch;
 mod sparse_forward;
+mod supernodal_llt;
 #[cfg(test)]
 mod test_matrices;
 mod top_columns;

@@ -4,7 +4,13 @@
 
 /// Bottom first; a module may import the ones of lower layers only.
 const LAYERS: &[&[&str]] = &[
-    &["block_tree", "column_layout", "permute", "pivots"],
+    &[
+        "block_tree",
+        "column_layout",
+        "permute",
+        "pivots",
+        "supernodal_llt",
+    ],
     &["block_kernels", "prefetch", "top_columns"],
     &["dense_forward"],
     &["block_solve", "sparse_forward"],

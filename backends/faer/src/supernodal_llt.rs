@@ -1,0 +1,745 @@
+//! A supernodal LLᵀ that factorizes independent subtrees of the supernodal elimination tree on
+//! separate threads (left-looking, on faer's symbolic structure and dense kernels).
+//!
+//! faer's own supernodal kernel walks the supernodes one after another and parallelizes only
+//! inside the dense kernels of one supernode, which on fiber-network matrices are mostly too
+//! small to split (a node's 6×6 block, a few neighbours). Here the tree is cut into *tasks*:
+//! subtrees light enough to factorize on one thread, and the heavy supernodes above them, each
+//! started once its children are done and factorized with every thread when its own work is
+//! large. A supernode's numeric step is the textbook left-looking one (George & Liu;
+//! CHOLMOD's supernodal numeric factorization): gather A's columns, subtract every descendant's
+//! update L_d,bottom L_d,midᵀ, factorize the diagonal block and solve the rows below it.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{
+    cholesky_in_place, cholesky_in_place_scratch, LltError, LltRegularization,
+};
+use faer::linalg::matmul::{matmul, triangular};
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
+use faer::sparse::SparseColMatRef;
+use faer::{Accum, MatMut, MatRef, Par, Spec};
+use std::marker::PhantomData;
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+type Symbolic = SymbolicSupernodalCholesky<usize>;
+
+/// No parent (a root of the supernodal forest).
+const NONE: usize = usize::MAX;
+
+/// Where the tree is cut into tasks (work counted as Σ c_j² over columns j with c_j entries).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TaskSizes {
+    /// A subtree is one task when its work is below this or below 1/(16 × threads) of the
+    /// whole: ≥ 0.1 ms at the ≈ 10 GFLOP/s of small supernodes, far above the microseconds of
+    /// starting a task, and about 16 tasks per thread to balance.
+    pub(crate) min_task: f64,
+    /// A heavy supernode's own work above which its updates and dense kernels are split over
+    /// the threads.
+    pub(crate) parallel_node: f64,
+}
+
+impl Default for TaskSizes {
+    fn default() -> Self {
+        TaskSizes {
+            min_task: 1e6,
+            parallel_node: 2e7,
+        }
+    }
+}
+
+/// The task structure of a supernodal factor, computed once per analysis.
+pub(crate) struct SupernodalPlan {
+    /// Each supernode's parent in the supernodal elimination tree.
+    parent: Vec<usize>,
+    /// The descendants that update each supernode (`updater_ptr[s]..updater_ptr[s + 1]` of
+    /// `updaters`, ascending).
+    updater_ptr: Vec<usize>,
+    updaters: Vec<u32>,
+    /// The tasks that start the factorization: the light subtrees whose parent is heavy or
+    /// absent, each as its supernodes in ascending (a topological) order,
+    /// `light_nodes[light_ptr[k]..light_ptr[k + 1]]`, its root last.
+    light_ptr: Vec<usize>,
+    light_nodes: Vec<u32>,
+    /// Heavy supernodes: their number of children (light subtrees or heavy supernodes).
+    heavy_children: Vec<usize>,
+    heavy: Vec<bool>,
+    /// Supernodes whose updates (split by columns) and dense kernels run on every thread.
+    parallel_node: Vec<bool>,
+}
+
+impl SupernodalPlan {
+    /// The plan of `sym`, or `None` when a supernode's parent does not come after it (which
+    /// an elimination tree's numbering guarantees; the tasks rely on it) or the supernodes
+    /// do not fit 32-bit indices.
+    pub(crate) fn new(sym: &Symbolic, threads: usize, sizes: TaskSizes) -> Option<Self> {
+        let ns = sym.n_supernodes();
+        if u32::try_from(ns).is_err() {
+            return None;
+        }
+        let block_of = block_of_columns(sym);
+        let (parent, own) = tree(sym, &block_of);
+        // A child's columns come before its parent's, so ascending order is a topological
+        // order of every subtree.
+        let mut subtree = own.clone();
+        for s in 0..ns {
+            if parent[s] != NONE {
+                if parent[s] <= s {
+                    return None;
+                }
+                subtree[parent[s]] += subtree[s];
+            }
+        }
+        let (updater_ptr, updaters) = updaters(sym, &block_of);
+        let total: f64 = own.iter().sum();
+        let cut = if threads > 1 {
+            (total / (16 * threads) as f64).max(sizes.min_task)
+        } else {
+            f64::INFINITY
+        };
+        let heavy: Vec<bool> = subtree.iter().map(|&w| w > cut).collect();
+        let mut heavy_children = vec![0usize; ns];
+        for &p in &parent {
+            if p != NONE && heavy[p] {
+                heavy_children[p] += 1;
+            }
+        }
+        let (light_ptr, light_nodes) = light_tasks(&parent, &heavy);
+        let parallel_node = own
+            .iter()
+            .map(|&w| threads > 1 && w > sizes.parallel_node)
+            .collect();
+        Some(SupernodalPlan {
+            parent,
+            updater_ptr,
+            updaters,
+            light_ptr,
+            light_nodes,
+            heavy_children,
+            heavy,
+            parallel_node,
+        })
+    }
+}
+
+/// The supernode of every column.
+fn block_of_columns(sym: &Symbolic) -> Vec<usize> {
+    let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+    let mut block_of = vec![0usize; sym.nrows()];
+    for s in 0..sym.n_supernodes() {
+        block_of[begin[s]..end[s]].fill(s);
+    }
+    block_of
+}
+
+/// Each supernode's parent (the supernode of its first off-diagonal row) and own work
+/// Σ c_j² over its columns.
+fn tree(sym: &Symbolic, block_of: &[usize]) -> (Vec<usize>, Vec<f64>) {
+    (0..sym.n_supernodes())
+        .map(|s| {
+            let pattern = sym.supernode(s).pattern();
+            let width = sym.supernode_end()[s] - sym.supernode_begin()[s];
+            let rows = (width + pattern.len()) as f64;
+            let own: f64 = (0..width).map(|c| (rows - c as f64).powi(2)).sum();
+            (pattern.first().map_or(NONE, |&r| block_of[r]), own)
+        })
+        .unzip()
+}
+
+/// For every supernode s, the descendants d with a row in s's columns (ascending), in CSR
+/// form: the supernodes that d's pattern touches.
+fn updaters(sym: &Symbolic, block_of: &[usize]) -> (Vec<usize>, Vec<u32>) {
+    let ns = sym.n_supernodes();
+    let touched = |d: usize| {
+        let mut last = NONE;
+        sym.supernode(d).pattern().iter().filter_map(move |&r| {
+            let t = block_of[r];
+            (t != last).then(|| {
+                last = t;
+                t
+            })
+        })
+    };
+    let mut ptr = vec![0usize; ns + 1];
+    for d in 0..ns {
+        for t in touched(d) {
+            ptr[t + 1] += 1;
+        }
+    }
+    for s in 0..ns {
+        ptr[s + 1] += ptr[s];
+    }
+    let mut updaters = vec![0u32; ptr[ns]];
+    let mut next = ptr.clone();
+    for d in 0..ns {
+        for t in touched(d) {
+            // Fits: the plan checked ns ≤ u32::MAX.
+            updaters[next[t]] = d as u32;
+            next[t] += 1;
+        }
+    }
+    (ptr, updaters)
+}
+
+/// The light subtrees below heavy supernodes (or at the roots), each as its supernodes in
+/// ascending order, in CSR form.
+fn light_tasks(parent: &[usize], heavy: &[bool]) -> (Vec<usize>, Vec<u32>) {
+    let ns = parent.len();
+    // Each light supernode's task, named by the root of its light subtree.
+    let mut task = vec![NONE; ns];
+    for s in (0..ns).rev() {
+        let p = parent[s];
+        if !heavy[s] {
+            task[s] = if p == NONE || heavy[p] { s } else { task[p] };
+        }
+    }
+    let mut slot = vec![NONE; ns];
+    let mut roots = 0;
+    for s in 0..ns {
+        if task[s] == s {
+            slot[s] = roots;
+            roots += 1;
+        }
+    }
+    let mut ptr = vec![0usize; roots + 1];
+    for &t in task.iter().filter(|&&t| t != NONE) {
+        ptr[slot[t] + 1] += 1;
+    }
+    for k in 0..roots {
+        ptr[k + 1] += ptr[k];
+    }
+    let mut nodes = vec![0u32; ptr[roots]];
+    let mut next = ptr.clone();
+    for (s, &t) in task.iter().enumerate().filter(|(_, &t)| t != NONE) {
+        nodes[next[slot[t]]] = s as u32;
+        next[slot[t]] += 1;
+    }
+    (ptr, nodes)
+}
+
+/// The values of L, written by one task per supernode and read by its ancestors' tasks.
+struct SharedFactor<'a> {
+    ptr: *mut f64,
+    len: usize,
+    _values: PhantomData<&'a mut [f64]>,
+}
+
+// SAFETY: access goes through `block` and `block_mut`, whose contracts exclude a read or write
+// of a block while another task writes it.
+unsafe impl Sync for SharedFactor<'_> {}
+unsafe impl Send for SharedFactor<'_> {}
+
+impl<'a> SharedFactor<'a> {
+    fn new(values: &'a mut [f64]) -> Self {
+        SharedFactor {
+            ptr: values.as_mut_ptr(),
+            len: values.len(),
+            _values: PhantomData,
+        }
+    }
+
+    /// The values `range`, to write.
+    ///
+    /// # Safety
+    /// No other task reads or writes `range` while the borrow lives (bounds are checked).
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn block_mut(&self, range: std::ops::Range<usize>) -> &mut [f64] {
+        assert!(range.start <= range.end && range.end <= self.len);
+        // SAFETY: in bounds; exclusivity is the caller's contract.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
+    }
+
+    /// The values `range`, to read.
+    ///
+    /// # Safety
+    /// No task writes `range` while the borrow lives (bounds are checked).
+    unsafe fn block(&self, range: std::ops::Range<usize>) -> &[f64] {
+        assert!(range.start <= range.end && range.end <= self.len);
+        // SAFETY: in bounds; no concurrent writer is the caller's contract.
+        unsafe { std::slice::from_raw_parts(self.ptr.add(range.start), range.len()) }
+    }
+}
+
+/// Scratch of one task: local row positions, an update block, the dense Cholesky's stack.
+#[derive(Default)]
+struct Scratch {
+    local: Vec<usize>,
+    update: Vec<f64>,
+    stack: Option<MemBuffer>,
+    stack_dim: usize,
+}
+
+/// The first non-positive pivot (in the factor's order) met by any task.
+struct Failure {
+    any: AtomicBool,
+    first: Mutex<Option<usize>>,
+}
+
+impl Failure {
+    fn record(&self, index: usize) {
+        self.any.store(true, Ordering::Release);
+        let mut f = self.first.lock().unwrap_or_else(|e| e.into_inner());
+        *f = Some(f.map_or(index, |g| g.min(index)));
+    }
+}
+
+/// What every task reads: the symbolic factor, A's lower triangle in the factor's order, the
+/// plan, the factor being written and the failure flag.
+struct Context<'a> {
+    sym: &'a Symbolic,
+    a: SparseColMatRef<'a, usize, f64>,
+    plan: &'a SupernodalPlan,
+    values: SharedFactor<'a>,
+    pending: Vec<AtomicUsize>,
+    failure: Failure,
+    threads: usize,
+    /// Scratch of finished tasks, for the next ones (freed with the context).
+    scratch: Mutex<Vec<Scratch>>,
+}
+
+/// Factorizes `a` (the lower triangle, in the factor's order) into `values` (faer's supernodal
+/// layout of `sym`). `Err(LltError::NonPositivePivot)` names the first failing column found,
+/// in the factor's order.
+pub(crate) fn factorize_llt(
+    values: &mut [f64],
+    a: SparseColMatRef<'_, usize, f64>,
+    sym: &Symbolic,
+    plan: &SupernodalPlan,
+    threads: usize,
+) -> Result<(), LltError> {
+    assert_eq!(values.len(), sym.len_val());
+    let ctx = Context {
+        sym,
+        a,
+        plan,
+        values: SharedFactor::new(values),
+        pending: plan
+            .heavy_children
+            .iter()
+            .map(|&c| AtomicUsize::new(c))
+            .collect(),
+        failure: Failure {
+            any: AtomicBool::new(false),
+            first: Mutex::new(None),
+        },
+        threads,
+        scratch: Mutex::new(Vec::new()),
+    };
+    if threads <= 1 {
+        let mut scratch = Scratch::default();
+        for s in 0..sym.n_supernodes() {
+            if let Err(k) = ctx.node(s, Par::Seq, &mut scratch) {
+                ctx.failure.record(k);
+                break;
+            }
+        }
+    } else {
+        rayon::scope(|scope| {
+            for k in 0..plan.light_ptr.len() - 1 {
+                let ctx = &ctx;
+                let nodes = &plan.light_nodes[plan.light_ptr[k]..plan.light_ptr[k + 1]];
+                scope.spawn(move |scope| ctx.light_task(scope, nodes));
+            }
+            for s in 0..sym.n_supernodes() {
+                if plan.heavy[s] && plan.heavy_children[s] == 0 {
+                    let ctx = &ctx;
+                    scope.spawn(move |scope| ctx.heavy_task(scope, s));
+                }
+            }
+        });
+    }
+    let first = ctx
+        .failure
+        .first
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner());
+    match first {
+        Some(index) => Err(LltError::NonPositivePivot { index }),
+        None => Ok(()),
+    }
+}
+
+impl<'a> Context<'a> {
+    /// A light subtree (its supernodes, root last) on this thread, then its parent when it was
+    /// the last child to finish.
+    fn light_task<'s>(&'s self, scope: &rayon::Scope<'s>, nodes: &'s [u32]) {
+        let mut scratch = self.take_scratch();
+        for &s in nodes {
+            if self.failure.any.load(Ordering::Acquire) {
+                return;
+            }
+            if let Err(k) = self.node(s as usize, Par::Seq, &mut scratch) {
+                self.failure.record(k);
+                return;
+            }
+        }
+        self.put_scratch(scratch);
+        if let Some(&root) = nodes.last() {
+            self.finished(scope, root as usize);
+        }
+    }
+
+    /// The heavy supernode `s` (its children are done).
+    fn heavy_task<'s>(&'s self, scope: &rayon::Scope<'s>, s: usize) {
+        if self.failure.any.load(Ordering::Acquire) {
+            return;
+        }
+        let par = if self.plan.parallel_node[s] {
+            Par::rayon(self.threads)
+        } else {
+            Par::Seq
+        };
+        let mut scratch = self.take_scratch();
+        if let Err(k) = self.node(s, par, &mut scratch) {
+            self.failure.record(k);
+            return;
+        }
+        self.put_scratch(scratch);
+        self.finished(scope, s);
+    }
+
+    fn take_scratch(&self) -> Scratch {
+        let mut pool = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        pool.pop().unwrap_or_default()
+    }
+
+    fn put_scratch(&self, scratch: Scratch) {
+        let mut pool = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        pool.push(scratch);
+    }
+
+    /// Counts `s` off its parent's children and starts the parent after the last one.
+    fn finished<'s>(&'s self, scope: &rayon::Scope<'s>, s: usize) {
+        let p = self.plan.parent[s];
+        // AcqRel: the parent's task sees every child's writes to the factor.
+        if p != NONE && self.pending[p].fetch_sub(1, Ordering::AcqRel) == 1 {
+            scope.spawn(move |scope| self.heavy_task(scope, p));
+        }
+    }
+
+    /// The value range and shape (columns, rows) of supernode `s`.
+    fn shape(&self, s: usize) -> (std::ops::Range<usize>, usize, usize, &'a [usize]) {
+        let sym = self.sym;
+        let (b, e) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
+        let pattern = sym.supernode(s).pattern();
+        let values = sym.col_ptr_for_val()[s]..sym.col_ptr_for_val()[s + 1];
+        (values, e - b, e - b + pattern.len(), pattern)
+    }
+
+    /// Supernode `s`: gather A, subtract the descendants' updates, factorize (Err: the failing
+    /// column in the factor's order).
+    fn node(&self, s: usize, par: Par, scratch: &mut Scratch) -> Result<(), usize> {
+        let (range, width, rows, pattern) = self.shape(s);
+        let begin = self.sym.supernode_begin()[s];
+        // SAFETY: supernode s is written by this task only, and read by its ancestors' tasks,
+        // which start after this one ends.
+        let ls = unsafe { self.values.block_mut(range) };
+        ls.fill(0.0);
+        for j in 0..width {
+            let col = begin + j;
+            let (r, v) = (self.a.row_idx_of_col(col), self.a.val_of_col(col));
+            for (i, &x) in r.zip(v) {
+                if i < col {
+                    continue;
+                }
+                let local = if i < begin + width {
+                    i - begin
+                } else {
+                    let at = pattern.binary_search(&i);
+                    width + at.expect("A's entries lie in the symbolic factor's pattern")
+                };
+                ls[local + j * rows] += x;
+            }
+        }
+        let mut l = MatMut::from_column_major_slice_mut(ls, rows, width);
+        if par == Par::Seq || width < 2 {
+            self.updates(l.rb_mut(), s, 0..width, scratch);
+        } else {
+            // Two column blocks of about equal work (column j holds rows − j entries), each
+            // updated by every descendant on its own thread.
+            let total = (width * (2 * rows - width + 1)) / 2;
+            let mut split = 1;
+            while split < width - 1 && split * (2 * rows - split + 1) < total {
+                split += 1;
+            }
+            let (left, right) = l.rb_mut().split_at_col_mut(split);
+            let mut other = self.take_scratch();
+            rayon::join(
+                || self.updates(left, s, 0..split, scratch),
+                || self.updates(right, s, split..width, &mut other),
+            );
+            self.put_scratch(other);
+        }
+        let (mut top, bottom) = l.split_at_row_mut(width);
+        if scratch.stack.is_none() || scratch.stack_dim < width {
+            let req = cholesky_in_place_scratch::<f64>(width, par, Spec::default());
+            scratch.stack = Some(MemBuffer::new(req));
+            scratch.stack_dim = width;
+        }
+        let stack = MemStack::new(scratch.stack.as_mut().expect("allocated above"));
+        let reg = LltRegularization::default();
+        match cholesky_in_place(top.rb_mut(), reg, par, stack, Spec::default()) {
+            Ok(_) => {}
+            Err(LltError::NonPositivePivot { index }) => return Err(begin + index),
+        }
+        solve_lower_triangular_in_place(top.rb(), bottom.transpose_mut(), par);
+        Ok(())
+    }
+
+    /// Subtracts every descendant's update from the columns `cols` of supernode `s`, held in
+    /// `l` (all of s's rows, those columns).
+    fn updates(&self, mut l: MatMut<'_, f64>, s: usize, cols: Range<usize>, scratch: &mut Scratch) {
+        let (up, down) = (self.plan.updater_ptr[s], self.plan.updater_ptr[s + 1]);
+        for &d in &self.plan.updaters[up..down] {
+            self.update(l.rb_mut(), s, d as usize, cols.clone(), scratch);
+        }
+    }
+
+    /// Subtracts descendant `d`'s update L_d,below L_d,midᵀ from the columns `cols` of
+    /// supernode `s`, held in `l`.
+    fn update(
+        &self,
+        l: MatMut<'_, f64>,
+        s: usize,
+        d: usize,
+        cols: Range<usize>,
+        scratch: &mut Scratch,
+    ) {
+        let (range, d_width, d_rows, d_pattern) = self.shape(d);
+        let (_, width, _, pattern) = self.shape(s);
+        let begin = self.sym.supernode_begin()[s];
+        // The rows of d in s's columns `cols`, and below them.
+        let p0 = d_pattern.partition_point(|&r| r < begin + cols.start);
+        let rows = &d_pattern[p0..];
+        let m = rows.partition_point(|&r| r < begin + cols.end);
+        if m == 0 {
+            return;
+        }
+        // Their positions in s: its columns, then its pattern (a superset of d's).
+        let local = &mut scratch.local;
+        local.clear();
+        local.extend(
+            rows.iter()
+                .take_while(|&&r| r < begin + width)
+                .map(|&r| r - begin),
+        );
+        let mut at = 0;
+        for &r in &rows[local.len()..] {
+            at += pattern[at..].partition_point(|&q| q < r);
+            local.push(width + at);
+        }
+        // SAFETY: d is a descendant of s, whose task ended before this one started.
+        let ld =
+            MatRef::from_column_major_slice(unsafe { self.values.block(range) }, d_rows, d_width);
+        let below = ld.subrows(d_width + p0, rows.len());
+        let mid = below.subrows(0, m);
+        let n = rows.len();
+        let contiguous = local[n - 1] - local[0] + 1 == n;
+        if contiguous {
+            let dst = l.submatrix_mut(local[0], local[0] - cols.start, n, m);
+            product(dst, below, mid, Accum::Add);
+            return;
+        }
+        if scratch.update.len() < n * m {
+            scratch.update.resize(n * m, 0.0);
+        }
+        let w = MatMut::from_column_major_slice_mut(&mut scratch.update[..n * m], n, m);
+        product(w, below, mid, Accum::Replace);
+        // Scatter the lower trapezoid of the product: column j of it goes to s's column
+        // local[j], its rows i ≥ j to rows local[i].
+        let w = &scratch.update[..n * m];
+        let stride = l.col_stride() as usize;
+        let (lrows, lcols) = (l.nrows(), l.ncols());
+        let dst = l.as_ptr_mut();
+        assert!(local[n - 1] < lrows && local[m - 1] - cols.start < lcols);
+        for j in 0..m {
+            let col = (local[j] - cols.start) * stride;
+            for i in j..n {
+                // SAFETY: local is ascending, local[n - 1] < rows of l and local[m - 1] is in
+                // its columns (checked above), and l is column-major with this stride.
+                unsafe { *dst.add(local[i] + col) += w[i + j * n] };
+            }
+        }
+    }
+}
+
+/// dst = (or +=, by `accum`) −below · midᵀ, `mid` being `below`'s first rows: the top square
+/// only on and below its diagonal.
+fn product(dst: MatMut<'_, f64>, below: MatRef<'_, f64>, mid: MatRef<'_, f64>, accum: Accum) {
+    let par = Par::Seq;
+    let m = mid.nrows();
+    let (top, bottom) = dst.split_at_row_mut(m);
+    triangular::matmul(
+        top,
+        triangular::BlockStructure::TriangularLower,
+        accum,
+        mid,
+        triangular::BlockStructure::Rectangular,
+        mid.transpose(),
+        triangular::BlockStructure::Rectangular,
+        -1.0,
+        par,
+    );
+    matmul(
+        bottom,
+        accum,
+        below.subrows(m, below.nrows() - m),
+        mid.transpose(),
+        -1.0,
+        par,
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_matrices::grid;
+    use faer::dyn_stack::MemBuffer;
+    use faer::sparse::linalg::cholesky::{
+        factorize_symbolic_cholesky, supernodal, CholeskySymbolicParams, SymbolicCholesky,
+        SymbolicCholeskyRaw, SymmetricOrdering,
+    };
+    use faer::sparse::SymbolicSparseColMatRef;
+    use fibercell_solver::{CscMatrix, LowerTriangle};
+
+    /// A's lower triangle in the factor's order and its supernodal symbolic factor (AMD).
+    fn setup(a: &CscMatrix) -> (LowerTriangle, Vec<f64>, SymbolicCholesky<usize>) {
+        let n = a.as_ref().ncols();
+        let lower = LowerTriangle::of(a.as_ref());
+        let pattern =
+            SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold:
+                faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let sym =
+            factorize_symbolic_cholesky(pattern, faer::Side::Lower, SymmetricOrdering::Amd, params)
+                .unwrap();
+        let (fwd, inv) = sym.perm().unwrap().arrays();
+        let permuted = lower.permuted(inv);
+        let mut scale = vec![0.0; n];
+        let mut values = vec![0.0; permuted.nnz()];
+        permuted
+            .scaled_permuted_values(a.as_ref(), fwd, &mut scale, &mut values)
+            .unwrap();
+        (permuted, values, sym)
+    }
+
+    fn supernodal_of(sym: &SymbolicCholesky<usize>) -> &Symbolic {
+        match sym.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => sn,
+            SymbolicCholeskyRaw::Simplicial(_) => panic!("forced supernodal"),
+        }
+    }
+
+    /// faer's sequential supernodal kernel on the same input.
+    fn faer_llt(
+        lower: &LowerTriangle,
+        values: &[f64],
+        sn: &Symbolic,
+    ) -> Result<Vec<f64>, LltError> {
+        let n = sn.nrows();
+        let a = SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx),
+            values,
+        );
+        let mut l = vec![0.0; sn.len_val()];
+        let req = supernodal::factorize_supernodal_numeric_llt_scratch::<usize, f64>(
+            sn,
+            Par::Seq,
+            Spec::default(),
+        );
+        let mut mem = MemBuffer::new(req);
+        supernodal::factorize_supernodal_numeric_llt(
+            &mut l,
+            a,
+            LltRegularization::default(),
+            sn,
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Spec::default(),
+        )?;
+        Ok(l)
+    }
+
+    fn ours(
+        lower: &LowerTriangle,
+        values: &[f64],
+        sn: &Symbolic,
+        threads: usize,
+        sizes: TaskSizes,
+    ) -> Result<Vec<f64>, LltError> {
+        let n = sn.nrows();
+        let a = SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx),
+            values,
+        );
+        let plan =
+            SupernodalPlan::new(sn, threads, sizes).expect("an elimination tree's numbering");
+        let mut l = vec![0.0; sn.len_val()];
+        factorize_llt(&mut l, a, sn, &plan, threads)?;
+        Ok(l)
+    }
+
+    /// Cuts small enough that a 10³ grid has light subtrees, heavy supernodes and supernodes
+    /// whose updates are split over two threads.
+    const TINY: TaskSizes = TaskSizes {
+        min_task: 1e3,
+        parallel_node: 1e4,
+    };
+
+    #[test]
+    fn every_schedule_gives_faers_factor() {
+        let a = grid(10);
+        let (lower, values, sym) = setup(&a);
+        let sn = supernodal_of(&sym);
+        let reference = faer_llt(&lower, &values, sn).unwrap();
+        let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (threads, sizes) in [
+            (1, TaskSizes::default()),
+            (2, TaskSizes::default()),
+            (2, TINY),
+            (3, TINY),
+        ] {
+            let l = ours(&lower, &values, sn, threads, sizes).unwrap();
+            // Same operations in another order of the sums: agreement to rounding.
+            let diff = l
+                .iter()
+                .zip(&reference)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(
+                diff <= 1e-13 * scale,
+                "threads {threads} {sizes:?}: {diff:e} of {scale:e}"
+            );
+        }
+        let plan = SupernodalPlan::new(sn, 2, TINY).unwrap();
+        assert!(plan.heavy.iter().any(|&h| h) && plan.light_ptr.len() > 2);
+        assert!(plan.parallel_node.iter().any(|&p| p));
+    }
+
+    #[test]
+    fn a_failing_pivot_is_reported_at_its_column() {
+        // An indefinite matrix: the grid with one diagonal entry replaced by a negative one.
+        let a = grid(6);
+        let (lower, mut values, sym) = setup(&a);
+        let sn = supernodal_of(&sym);
+        let column = 100;
+        let diagonal = lower.col_ptr[column];
+        assert_eq!(lower.row_idx[diagonal], column);
+        values[diagonal] = -1.0;
+        let expected = match faer_llt(&lower, &values, sn) {
+            Err(LltError::NonPositivePivot { index }) => index,
+            Ok(_) => panic!("faer factorized an indefinite matrix"),
+        };
+        for (threads, sizes) in [(1, TaskSizes::default()), (2, TINY)] {
+            match ours(&lower, &values, sn, threads, sizes) {
+                Err(LltError::NonPositivePivot { index }) => assert_eq!(index, expected),
+                Ok(_) => panic!("threads {threads}: factorized an indefinite matrix"),
+            }
+        }
+    }
+}
