@@ -313,6 +313,10 @@ enum Command {
         rhs: Option<PathBuf>,
         #[command(flatten)]
         solver: SolverArgs,
+        /// Run the analysis and the factorization this many times and report their medians
+        /// (the factorizations reuse the last analysis).
+        #[arg(long, default_value_t = 1)]
+        repeats: usize,
         /// Print one JSON document.
         #[arg(long)]
         json: bool,
@@ -1440,6 +1444,7 @@ fn solve_matrix(
     matrix: &Path,
     rhs: Option<&Path>,
     solver: &SolverArgs,
+    repeats: usize,
     json: bool,
 ) -> Result<(), Error> {
     let in_file = |path: &Path, e: fibercell::solver::SolverError| {
@@ -1466,7 +1471,7 @@ fn solve_matrix(
         None => None,
     };
     let config = solver.options().solver_config(Vec::new());
-    let (_, r) = fibercell::solve::solve_matrix(a.as_ref(), b.as_deref(), &config)?;
+    let (_, r) = fibercell::solve::solve_matrix(a.as_ref(), b.as_deref(), &config, repeats)?;
     if json {
         println!("{}", to_pretty(&r)?);
         return Ok(());
@@ -1487,8 +1492,15 @@ fn solve_matrix(
         r.iterations.map_or("-".to_string(), |v| v.to_string())
     );
     println!(
-        "time (s): analyze {:.4}  factorize {:.4}  solve {:.4}",
-        r.analyze_seconds, r.factorize_seconds, r.solve_seconds
+        "time (s): analyze {:.4}  factorize {:.4}  solve {:.4}{}",
+        r.analyze_seconds,
+        r.factorize_seconds,
+        r.solve_seconds,
+        if r.repeats > 1 {
+            format!(" (medians of {} runs)", r.repeats)
+        } else {
+            String::new()
+        }
     );
     println!(
         "relative residual {:.2e}, backward error {:.2e}, max |x − 1| {}",
@@ -1730,8 +1742,9 @@ fn main() -> ExitCode {
             matrix,
             rhs,
             solver,
+            repeats,
             json,
-        } => solve_matrix(&matrix, rhs.as_deref(), &solver, json),
+        } => solve_matrix(&matrix, rhs.as_deref(), &solver, repeats, json),
         Command::Bench {
             cells,
             json,

@@ -695,7 +695,7 @@ fn export_matrix_of_a_cell_writes_its_cell_problems() {
     assert!(map.starts_with("row,node,dof\n1,"));
     // The exported first cell problem is nonsingular and solves to a backward error of 1e-14.
     let config = fibercell::solve::SolverConfig::default();
-    let (_, r) = fibercell::solve::solve_matrix(a.as_ref(), Some(&rhs[..n]), &config)
+    let (_, r) = fibercell::solve::solve_matrix(a.as_ref(), Some(&rhs[..n]), &config, 1)
         .expect("the cell matrix is not singular");
     assert!(r.backward_error <= 1e-14, "{}", r.backward_error);
 }
