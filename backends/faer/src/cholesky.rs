@@ -10,7 +10,7 @@ use crate::block_solve::{backward_in_place, forward_in_place, solve_in_place as 
 use crate::block_tree::{BlockTree, FactorView};
 use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
-use crate::supernodal_llt::{self, SupernodalPlan, TaskSizes};
+use crate::supernodal_llt::{self, ScaledLower, SupernodalPlan, TaskSizes};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
@@ -333,12 +333,33 @@ impl LinearSolver for FaerCholesky {
                 scale: vec![0.0; n],
             },
         };
+        if let (CholeskyVariant::Llt, SymbolicCholeskyRaw::Supernodal(sn), Some(plan)) =
+            (self.variant, an.symbolic.raw(), &an.plan)
+        {
+            // The scaled triangle is read where each supernode gathers it: no copy.
+            let scale = an.lower.permuted_scale(a, &an.factor_fwd, &mut f.scale)?;
+            let scaled = ScaledLower {
+                lower: &an.lower,
+                values: a.values(),
+                scale: &scale,
+            };
+            let threads = threads(self.par);
+            supernodal_llt::factorize_llt(
+                &mut f.l_values,
+                scaled,
+                self.pivot_tolerance,
+                sn,
+                plan,
+                threads,
+            )
+            .map_err(|p| pivot_error(an.factor_fwd[p.index], p.value))?;
+            self.factor = Some(Arc::new(f));
+            return Ok(());
+        }
         let mut ws = match self.workspace.take() {
             Some(ws) => ws,
             None => {
                 let req = match (self.variant, an.symbolic.raw()) {
-                    // The task-parallel kernel keeps its own scratch.
-                    _ if an.plan.is_some() => faer::dyn_stack::StackReq::EMPTY,
                     (CholeskyVariant::Llt, SymbolicCholeskyRaw::Supernodal(sn)) => {
                         supernodal::factorize_supernodal_numeric_llt_scratch::<usize, f64>(
                             sn,
@@ -398,17 +419,9 @@ impl LinearSolver for FaerCholesky {
         match self.variant {
             CholeskyVariant::Llt => {
                 let reg = LltRegularization::default();
-                let r = match (supernodal, &an.plan) {
-                    // Independent subtrees on separate threads.
-                    (Some(sn), Some(plan)) => supernodal_llt::factorize_llt(
-                        &mut f.l_values,
-                        lower,
-                        sn,
-                        plan,
-                        threads(self.par),
-                    ),
+                let r = match supernodal {
                     // In the factor's order already: no permuted copy of A.
-                    (Some(sn), _) => supernodal::factorize_supernodal_numeric_llt(
+                    Some(sn) => supernodal::factorize_supernodal_numeric_llt(
                         &mut f.l_values,
                         lower,
                         reg,
@@ -418,7 +431,7 @@ impl LinearSolver for FaerCholesky {
                         Spec::default(),
                     )
                     .map(|_| ()),
-                    (None, _) => sym
+                    None => sym
                         .factorize_numeric_llt(
                             &mut f.l_values,
                             lower,

@@ -18,8 +18,8 @@ use faer::linalg::matmul::{matmul, triangular};
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
-use faer::sparse::SparseColMatRef;
 use faer::{Accum, MatMut, MatRef, Par, Spec};
+use fibercell_solver::LowerTriangle;
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -272,17 +272,38 @@ struct Scratch {
     stack_dim: usize,
 }
 
-/// The first non-positive pivot (in the factor's order) met by any task.
+/// A's lower triangle in the factor's order, read scaled (S A S) where a supernode gathers it.
+#[derive(Clone, Copy)]
+pub(crate) struct ScaledLower<'a> {
+    /// The triangle (made by `LowerTriangle::permuted`).
+    pub(crate) lower: &'a LowerTriangle,
+    /// A's values.
+    pub(crate) values: &'a [f64],
+    /// S in the factor's order.
+    pub(crate) scale: &'a [f64],
+}
+
+/// A pivot of the scaled matrix at or below the tolerance: its column in the factor's order
+/// and its value (0 when faer's dense kernel stopped at a non-positive one).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Pivot {
+    pub(crate) index: usize,
+    pub(crate) value: f64,
+}
+
+/// The failing pivot of the lowest column met by any task.
 struct Failure {
     any: AtomicBool,
-    first: Mutex<Option<usize>>,
+    first: Mutex<Option<Pivot>>,
 }
 
 impl Failure {
-    fn record(&self, index: usize) {
+    fn record(&self, pivot: Pivot) {
         self.any.store(true, Ordering::Release);
         let mut f = self.first.lock().unwrap_or_else(|e| e.into_inner());
-        *f = Some(f.map_or(index, |g| g.min(index)));
+        if f.is_none_or(|g| pivot.index < g.index) {
+            *f = Some(pivot);
+        }
     }
 }
 
@@ -290,7 +311,8 @@ impl Failure {
 /// plan, the factor being written and the failure flag.
 struct Context<'a> {
     sym: &'a Symbolic,
-    a: SparseColMatRef<'a, usize, f64>,
+    a: ScaledLower<'a>,
+    pivot_tolerance: f64,
     plan: &'a SupernodalPlan,
     values: SharedFactor<'a>,
     pending: Vec<AtomicUsize>,
@@ -300,20 +322,22 @@ struct Context<'a> {
     scratch: Mutex<Vec<Scratch>>,
 }
 
-/// Factorizes `a` (the lower triangle, in the factor's order) into `values` (faer's supernodal
-/// layout of `sym`). `Err(LltError::NonPositivePivot)` names the first failing column found,
-/// in the factor's order.
+/// Factorizes S A S (`a`) into `values` (faer's supernodal layout of `sym`) on `threads`
+/// threads. A pivot L_jj² at or below `pivot_tolerance` (the scaled diagonal being 1) is the
+/// error, the lowest such column found.
 pub(crate) fn factorize_llt(
     values: &mut [f64],
-    a: SparseColMatRef<'_, usize, f64>,
+    a: ScaledLower<'_>,
+    pivot_tolerance: f64,
     sym: &Symbolic,
     plan: &SupernodalPlan,
     threads: usize,
-) -> Result<(), LltError> {
+) -> Result<(), Pivot> {
     assert_eq!(values.len(), sym.len_val());
     let ctx = Context {
         sym,
         a,
+        pivot_tolerance,
         plan,
         values: SharedFactor::new(values),
         pending: plan
@@ -357,7 +381,7 @@ pub(crate) fn factorize_llt(
         .into_inner()
         .unwrap_or_else(|e| e.into_inner());
     match first {
-        Some(index) => Err(LltError::NonPositivePivot { index }),
+        Some(pivot) => Err(pivot),
         None => Ok(()),
     }
 }
@@ -429,9 +453,8 @@ impl<'a> Context<'a> {
         (values, e - b, e - b + pattern.len(), pattern)
     }
 
-    /// Supernode `s`: gather A, subtract the descendants' updates, factorize (Err: the failing
-    /// column in the factor's order).
-    fn node(&self, s: usize, par: Par, scratch: &mut Scratch) -> Result<(), usize> {
+    /// Supernode `s`: gather A, subtract the descendants' updates, factorize.
+    fn node(&self, s: usize, par: Par, scratch: &mut Scratch) -> Result<(), Pivot> {
         let (range, width, rows, pattern) = self.shape(s);
         let begin = self.sym.supernode_begin()[s];
         // SAFETY: supernode s is written by this task only, and read by its ancestors' tasks,
@@ -440,11 +463,8 @@ impl<'a> Context<'a> {
         ls.fill(0.0);
         for j in 0..width {
             let col = begin + j;
-            let (r, v) = (self.a.row_idx_of_col(col), self.a.val_of_col(col));
-            for (i, &x) in r.zip(v) {
-                if i < col {
-                    continue;
-                }
+            let a = self.a;
+            for (i, x) in a.lower.scaled_column(a.values, a.scale, col) {
                 let local = if i < begin + width {
                     i - begin
                 } else {
@@ -481,9 +501,23 @@ impl<'a> Context<'a> {
         }
         let stack = MemStack::new(scratch.stack.as_mut().expect("allocated above"));
         let reg = LltRegularization::default();
-        match cholesky_in_place(top.rb_mut(), reg, par, stack, Spec::default()) {
-            Ok(_) => {}
-            Err(LltError::NonPositivePivot { index }) => return Err(begin + index),
+        if let Err(LltError::NonPositivePivot { index }) =
+            cholesky_in_place(top.rb_mut(), reg, par, stack, Spec::default())
+        {
+            return Err(Pivot {
+                index: begin + index,
+                value: 0.0,
+            });
+        }
+        // faer accepts tiny positive pivots: judge them against the (unit) scaled diagonal.
+        for c in 0..width {
+            let pivot = top[(c, c)] * top[(c, c)];
+            if !(pivot > self.pivot_tolerance) {
+                return Err(Pivot {
+                    index: begin + c,
+                    value: pivot,
+                });
+            }
         }
         solve_lower_triangular_in_place(top.rb(), bottom.transpose_mut(), par);
         Ok(())
@@ -597,92 +631,104 @@ fn product(dst: MatMut<'_, f64>, below: MatRef<'_, f64>, mid: MatRef<'_, f64>, a
 mod tests {
     use super::*;
     use crate::test_matrices::grid;
-    use faer::dyn_stack::MemBuffer;
     use faer::sparse::linalg::cholesky::{
         factorize_symbolic_cholesky, supernodal, CholeskySymbolicParams, SymbolicCholesky,
         SymbolicCholeskyRaw, SymmetricOrdering,
     };
-    use faer::sparse::SymbolicSparseColMatRef;
-    use fibercell_solver::{CscMatrix, LowerTriangle};
+    use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+    use faer::Side;
+    use fibercell_solver::CscMatrix;
 
-    /// A's lower triangle in the factor's order and its supernodal symbolic factor (AMD).
-    fn setup(a: &CscMatrix) -> (LowerTriangle, Vec<f64>, SymbolicCholesky<usize>) {
-        let n = a.as_ref().ncols();
-        let lower = LowerTriangle::of(a.as_ref());
-        let pattern =
-            SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx);
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold:
-                faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        let sym =
-            factorize_symbolic_cholesky(pattern, faer::Side::Lower, SymmetricOrdering::Amd, params)
+    /// A matrix with its lower triangle in the factor's order (AMD, supernodal), the scale in
+    /// that order and the scaled values as a copy for faer's kernel.
+    struct Case {
+        a: CscMatrix,
+        lower: LowerTriangle,
+        scale: Vec<f64>,
+        scaled: Vec<f64>,
+        sym: SymbolicCholesky<usize>,
+    }
+
+    impl Case {
+        fn new(a: CscMatrix) -> Self {
+            let n = a.as_ref().ncols();
+            let full = LowerTriangle::of(a.as_ref());
+            let pattern =
+                SymbolicSparseColMatRef::new_checked(n, n, &full.col_ptr, None, &full.row_idx);
+            let params = CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold:
+                    faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            };
+            let sym =
+                factorize_symbolic_cholesky(pattern, Side::Lower, SymmetricOrdering::Amd, params)
+                    .unwrap();
+            let (fwd, inv) = sym.perm().unwrap().arrays();
+            let lower = full.permuted(inv);
+            let mut by_old = vec![0.0; n];
+            let mut scaled = vec![0.0; lower.nnz()];
+            lower
+                .scaled_permuted_values(a.as_ref(), fwd, &mut by_old, &mut scaled)
                 .unwrap();
-        let (fwd, inv) = sym.perm().unwrap().arrays();
-        let permuted = lower.permuted(inv);
-        let mut scale = vec![0.0; n];
-        let mut values = vec![0.0; permuted.nnz()];
-        permuted
-            .scaled_permuted_values(a.as_ref(), fwd, &mut scale, &mut values)
-            .unwrap();
-        (permuted, values, sym)
-    }
-
-    fn supernodal_of(sym: &SymbolicCholesky<usize>) -> &Symbolic {
-        match sym.raw() {
-            SymbolicCholeskyRaw::Supernodal(sn) => sn,
-            SymbolicCholeskyRaw::Simplicial(_) => panic!("forced supernodal"),
+            let scale = lower.permuted_scale(a.as_ref(), fwd, &mut by_old).unwrap();
+            Case {
+                a,
+                lower,
+                scale,
+                scaled,
+                sym,
+            }
         }
-    }
 
-    /// faer's sequential supernodal kernel on the same input.
-    fn faer_llt(
-        lower: &LowerTriangle,
-        values: &[f64],
-        sn: &Symbolic,
-    ) -> Result<Vec<f64>, LltError> {
-        let n = sn.nrows();
-        let a = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx),
-            values,
-        );
-        let mut l = vec![0.0; sn.len_val()];
-        let req = supernodal::factorize_supernodal_numeric_llt_scratch::<usize, f64>(
-            sn,
-            Par::Seq,
-            Spec::default(),
-        );
-        let mut mem = MemBuffer::new(req);
-        supernodal::factorize_supernodal_numeric_llt(
-            &mut l,
-            a,
-            LltRegularization::default(),
-            sn,
-            Par::Seq,
-            MemStack::new(&mut mem),
-            Spec::default(),
-        )?;
-        Ok(l)
-    }
+        fn supernodal(&self) -> &Symbolic {
+            match self.sym.raw() {
+                SymbolicCholeskyRaw::Supernodal(sn) => sn,
+                SymbolicCholeskyRaw::Simplicial(_) => panic!("forced supernodal"),
+            }
+        }
 
-    fn ours(
-        lower: &LowerTriangle,
-        values: &[f64],
-        sn: &Symbolic,
-        threads: usize,
-        sizes: TaskSizes,
-    ) -> Result<Vec<f64>, LltError> {
-        let n = sn.nrows();
-        let a = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx),
-            values,
-        );
-        let plan =
-            SupernodalPlan::new(sn, threads, sizes).expect("an elimination tree's numbering");
-        let mut l = vec![0.0; sn.len_val()];
-        factorize_llt(&mut l, a, sn, &plan, threads)?;
-        Ok(l)
+        /// faer's sequential supernodal kernel on the scaled copy.
+        fn faer_llt(&self) -> Result<Vec<f64>, LltError> {
+            let sn = self.supernodal();
+            let n = sn.nrows();
+            let lower = &self.lower;
+            let a = SparseColMatRef::new(
+                SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx),
+                &self.scaled[..],
+            );
+            let mut l = vec![0.0; sn.len_val()];
+            let req = supernodal::factorize_supernodal_numeric_llt_scratch::<usize, f64>(
+                sn,
+                Par::Seq,
+                Spec::default(),
+            );
+            let mut mem = MemBuffer::new(req);
+            supernodal::factorize_supernodal_numeric_llt(
+                &mut l,
+                a,
+                LltRegularization::default(),
+                sn,
+                Par::Seq,
+                MemStack::new(&mut mem),
+                Spec::default(),
+            )?;
+            Ok(l)
+        }
+
+        /// This module's kernel, reading A scaled.
+        fn ours(&self, threads: usize, sizes: TaskSizes) -> Result<Vec<f64>, Pivot> {
+            let sn = self.supernodal();
+            let plan =
+                SupernodalPlan::new(sn, threads, sizes).expect("an elimination tree's numbering");
+            let a = ScaledLower {
+                lower: &self.lower,
+                values: self.a.as_ref().values(),
+                scale: &self.scale,
+            };
+            let mut l = vec![0.0; sn.len_val()];
+            factorize_llt(&mut l, a, 1e-12, sn, &plan, threads)?;
+            Ok(l)
+        }
     }
 
     /// Cuts small enough that a 10³ grid has light subtrees, heavy supernodes and supernodes
@@ -694,10 +740,8 @@ mod tests {
 
     #[test]
     fn every_schedule_gives_faers_factor() {
-        let a = grid(10);
-        let (lower, values, sym) = setup(&a);
-        let sn = supernodal_of(&sym);
-        let reference = faer_llt(&lower, &values, sn).unwrap();
+        let case = Case::new(grid(10));
+        let reference = case.faer_llt().unwrap();
         let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for (threads, sizes) in [
             (1, TaskSizes::default()),
@@ -705,7 +749,7 @@ mod tests {
             (2, TINY),
             (3, TINY),
         ] {
-            let l = ours(&lower, &values, sn, threads, sizes).unwrap();
+            let l = case.ours(threads, sizes).unwrap();
             // Same operations in another order of the sums: agreement to rounding.
             let diff = l
                 .iter()
@@ -716,28 +760,29 @@ mod tests {
                 "threads {threads} {sizes:?}: {diff:e} of {scale:e}"
             );
         }
-        let plan = SupernodalPlan::new(sn, 2, TINY).unwrap();
+        let plan = SupernodalPlan::new(case.supernodal(), 2, TINY).unwrap();
         assert!(plan.heavy.iter().any(|&h| h) && plan.light_ptr.len() > 2);
         assert!(plan.parallel_node.iter().any(|&p| p));
     }
 
     #[test]
     fn a_failing_pivot_is_reported_at_its_column() {
-        // An indefinite matrix: the grid with one diagonal entry replaced by a negative one.
-        let a = grid(6);
-        let (lower, mut values, sym) = setup(&a);
-        let sn = supernodal_of(&sym);
-        let column = 100;
-        let diagonal = lower.col_ptr[column];
-        assert_eq!(lower.row_idx[diagonal], column);
-        values[diagonal] = -1.0;
-        let expected = match faer_llt(&lower, &values, sn) {
+        // An indefinite matrix: the grid with one diagonal entry a thousandth of its row's
+        // off-diagonal sum (positive, so the scaling passes).
+        let mut a = grid(6);
+        let old = 100;
+        let k = (a.as_ref().col_ptr()[old]..a.as_ref().col_ptr()[old + 1])
+            .find(|&k| a.as_ref().row_idx()[k] == old)
+            .unwrap();
+        a.values_mut()[k] *= 1e-3;
+        let case = Case::new(a);
+        let expected = match case.faer_llt() {
             Err(LltError::NonPositivePivot { index }) => index,
             Ok(_) => panic!("faer factorized an indefinite matrix"),
         };
         for (threads, sizes) in [(1, TaskSizes::default()), (2, TINY)] {
-            match ours(&lower, &values, sn, threads, sizes) {
-                Err(LltError::NonPositivePivot { index }) => assert_eq!(index, expected),
+            match case.ours(threads, sizes) {
+                Err(p) => assert_eq!(p.index, expected, "threads {threads}"),
                 Ok(_) => panic!("threads {threads}: factorized an indefinite matrix"),
             }
         }
