@@ -73,11 +73,11 @@ pub(crate) struct SupernodalPlan {
 
 impl SupernodalPlan {
     /// The plan of `sym`, or `None` when a supernode's parent does not come after it (which
-    /// an elimination tree's numbering guarantees; the tasks rely on it) or the supernodes
-    /// do not fit 32-bit indices.
+    /// an elimination tree's numbering guarantees; the tasks rely on it) or the columns do
+    /// not fit 32-bit indices.
     pub(crate) fn new(sym: &Symbolic, threads: usize, sizes: TaskSizes) -> Option<Self> {
         let ns = sym.n_supernodes();
-        if u32::try_from(ns).is_err() {
+        if u32::try_from(sym.nrows()).is_err() {
             return None;
         }
         let block_of = block_of_columns(sym);
@@ -176,7 +176,7 @@ fn updaters(sym: &Symbolic, block_of: &[usize]) -> (Vec<usize>, Vec<u32>) {
     let mut next = ptr.clone();
     for d in 0..ns {
         for t in touched(d) {
-            // Fits: the plan checked ns ≤ u32::MAX.
+            // Fits: the plan checked n ≤ u32::MAX (and supernodes ≤ columns).
             updaters[next[t]] = d as u32;
             next[t] += 1;
         }
@@ -266,6 +266,9 @@ impl<'a> SharedFactor<'a> {
 /// Scratch of one task: local row positions, an update block, the dense Cholesky's stack.
 #[derive(Default)]
 struct Scratch {
+    /// Each row's position in the supernode being updated (its columns, then its pattern);
+    /// written for that supernode's rows before its updates, of length n.
+    position: Vec<u32>,
     local: Vec<usize>,
     update: Vec<f64>,
     stack: Option<MemBuffer>,
@@ -527,6 +530,20 @@ impl<'a> Context<'a> {
     /// `l` (all of s's rows, those columns).
     fn updates(&self, mut l: MatMut<'_, f64>, s: usize, cols: Range<usize>, scratch: &mut Scratch) {
         let (up, down) = (self.plan.updater_ptr[s], self.plan.updater_ptr[s + 1]);
+        if up == down {
+            return;
+        }
+        let (_, width, _, pattern) = self.shape(s);
+        let begin = self.sym.supernode_begin()[s];
+        let position = &mut scratch.position;
+        position.resize(self.sym.nrows(), 0);
+        // Fits: the plan checked n ≤ u32::MAX.
+        for (k, r) in (begin..begin + width)
+            .chain(pattern.iter().copied())
+            .enumerate()
+        {
+            position[r] = k as u32;
+        }
         for &d in &self.plan.updaters[up..down] {
             self.update(l.rb_mut(), s, d as usize, cols.clone(), scratch);
         }
@@ -543,7 +560,6 @@ impl<'a> Context<'a> {
         scratch: &mut Scratch,
     ) {
         let (range, d_width, d_rows, d_pattern) = self.shape(d);
-        let (_, width, _, pattern) = self.shape(s);
         let begin = self.sym.supernode_begin()[s];
         // The rows of d in s's columns `cols`, and below them.
         let p0 = d_pattern.partition_point(|&r| r < begin + cols.start);
@@ -552,19 +568,10 @@ impl<'a> Context<'a> {
         if m == 0 {
             return;
         }
-        // Their positions in s: its columns, then its pattern (a superset of d's).
+        // Their positions in s (d's pattern from s on lies in s's columns and pattern).
         let local = &mut scratch.local;
         local.clear();
-        local.extend(
-            rows.iter()
-                .take_while(|&&r| r < begin + width)
-                .map(|&r| r - begin),
-        );
-        let mut at = 0;
-        for &r in &rows[local.len()..] {
-            at += pattern[at..].partition_point(|&q| q < r);
-            local.push(width + at);
-        }
+        local.extend(rows.iter().map(|&r| scratch.position[r] as usize));
         // SAFETY: d is a descendant of s, whose task ended before this one started.
         let ld =
             MatRef::from_column_major_slice(unsafe { self.values.block(range) }, d_rows, d_width);
