@@ -78,11 +78,11 @@ impl StickSlip<'_, '_, '_> {
         };
         if slot.is_none() && !nonsymmetric {
             // The cell's shared analysis, when there is one.
-            *slot = setup
-                .shared
-                .as_ref()
-                .and_then(|s| s.solver())
-                .or(beside_reference);
+            let shared = setup.shared.as_ref();
+            *slot = shared.and_then(|s| s.solver()).or(beside_reference);
+            if factors.factor_bytes.is_none() {
+                factors.factor_bytes = shared.and_then(|s| s.factor_bytes());
+            }
         }
         if slot.is_none() {
             let mut s = SolverConfig {

@@ -25,6 +25,8 @@ pub(super) struct SharedReference {
     solver: Mutex<Box<dyn LinearSolver>>,
     /// What the factorization took (s): the states' measure of a factorization's cost.
     factorize_seconds: f64,
+    /// The bytes of the factor's values (from the analysis), for the states' memory rules.
+    factor_bytes: Option<usize>,
 }
 
 impl SharedReference {
@@ -45,9 +47,12 @@ impl SharedReference {
             ..setup.solver_config.clone()
         }
         .build()?;
-        if solver.share().is_none() || solver.analyze(a).is_err() {
+        if solver.share().is_none() {
             return Ok(None);
         }
+        let Ok(info) = solver.analyze(a) else {
+            return Ok(None);
+        };
         let started = std::time::Instant::now();
         if solver.factorize(a).is_err() {
             return Ok(None);
@@ -55,6 +60,7 @@ impl SharedReference {
         Ok(Some(SharedReference {
             blocks: reference_blocks(setup, &rest.contacts),
             factorize_seconds: started.elapsed().as_secs_f64(),
+            factor_bytes: info.nnz_factor.map(|nnz| 8 * nnz),
             values: Arc::new(values),
             solver: Mutex::new(solver),
         }))
@@ -75,6 +81,11 @@ impl SharedReference {
         self.factorize_seconds
     }
 
+    /// The bytes of the shared factor's values, when its analysis counted them.
+    pub(super) fn factor_bytes(&self) -> Option<usize> {
+        self.factor_bytes
+    }
+
     /// Makes the shared factorization the reference of `factors` and `matrix`, which have
     /// none: the contacts' changes since rest are then a low-rank correction of it.
     pub(super) fn adopt(&self, factors: &mut Factors, matrix: &mut MatrixValues) {
@@ -86,6 +97,7 @@ impl SharedReference {
         factors.refresh_reference = false;
         factors.reference_solution = None;
         factors.cost.factorize = Some(self.factorize_seconds);
+        factors.factor_bytes = self.factor_bytes;
         factors.low_rank.reset();
         factors.affine.clear();
         matrix.adopt_reference(&self.values);
