@@ -333,9 +333,8 @@ impl LinearSolver for FaerCholesky {
                 scale: vec![0.0; n],
             },
         };
-        if let (CholeskyVariant::Llt, SymbolicCholeskyRaw::Supernodal(sn), Some(plan)) =
-            (self.variant, an.symbolic.raw(), &an.plan)
-        {
+        // A plan exists for supernodal LLᵀ analyses only.
+        if let (SymbolicCholeskyRaw::Supernodal(sn), Some(plan)) = (an.symbolic.raw(), &an.plan) {
             // The scaled triangle is read where each supernode gathers it: no copy.
             let scale = an.lower.permuted_scale(a, &an.factor_fwd, &mut f.scale)?;
             let scaled = ScaledLower {

@@ -263,16 +263,23 @@ impl<'a> SharedFactor<'a> {
     }
 }
 
-/// Scratch of one task: local row positions, an update block, the dense Cholesky's stack.
+/// Scratch of one task: the row positions of the supernode being factorized, the update
+/// buffers, the dense Cholesky's stack.
 #[derive(Default)]
 struct Scratch {
-    /// Each row's position in the supernode being updated (its columns, then its pattern);
-    /// written for that supernode's rows before its updates, of length n.
+    /// Each row's position in the supernode being factorized (its columns, then its
+    /// pattern); written for that supernode's rows before it is gathered, of length n.
     position: Vec<u32>,
-    local: Vec<usize>,
-    update: Vec<f64>,
+    buffers: UpdateBuffers,
     stack: Option<MemBuffer>,
     stack_dim: usize,
+}
+
+/// What one descendant's update works in: its rows' positions and the product block.
+#[derive(Default)]
+struct UpdateBuffers {
+    local: Vec<usize>,
+    update: Vec<f64>,
 }
 
 /// A's lower triangle in the factor's order, read scaled (S A S) where a supernode gathers it.
@@ -464,22 +471,28 @@ impl<'a> Context<'a> {
         // which start after this one ends.
         let ls = unsafe { self.values.block_mut(range) };
         ls.fill(0.0);
+        let position = &mut scratch.position;
+        position.resize(self.sym.nrows(), 0);
+        // Fits: the plan checked n ≤ u32::MAX.
+        for (k, r) in (begin..begin + width)
+            .chain(pattern.iter().copied())
+            .enumerate()
+        {
+            position[r] = k as u32;
+        }
         for j in 0..width {
             let col = begin + j;
             let a = self.a;
             for (i, x) in a.lower.scaled_column(a.values, a.scale, col) {
-                let local = if i < begin + width {
-                    i - begin
-                } else {
-                    let at = pattern.binary_search(&i);
-                    width + at.expect("A's entries lie in the symbolic factor's pattern")
-                };
+                // A's entries lie in the factor's pattern.
+                let local = scratch.position[i] as usize;
                 ls[local + j * rows] += x;
             }
         }
         let mut l = MatMut::from_column_major_slice_mut(ls, rows, width);
+        let (position, buffers) = (&scratch.position, &mut scratch.buffers);
         if par == Par::Seq || width < 2 {
-            self.updates(l.rb_mut(), s, 0..width, scratch);
+            self.updates(l.rb_mut(), s, 0..width, position, buffers);
         } else {
             // Two column blocks of about equal work (column j holds rows − j entries), each
             // updated by every descendant on its own thread.
@@ -491,8 +504,8 @@ impl<'a> Context<'a> {
             let (left, right) = l.rb_mut().split_at_col_mut(split);
             let mut other = self.take_scratch();
             rayon::join(
-                || self.updates(left, s, 0..split, scratch),
-                || self.updates(right, s, split..width, &mut other),
+                || self.updates(left, s, 0..split, position, buffers),
+                || self.updates(right, s, split..width, position, &mut other.buffers),
             );
             self.put_scratch(other);
         }
@@ -528,24 +541,17 @@ impl<'a> Context<'a> {
 
     /// Subtracts every descendant's update from the columns `cols` of supernode `s`, held in
     /// `l` (all of s's rows, those columns).
-    fn updates(&self, mut l: MatMut<'_, f64>, s: usize, cols: Range<usize>, scratch: &mut Scratch) {
+    fn updates(
+        &self,
+        mut l: MatMut<'_, f64>,
+        s: usize,
+        cols: Range<usize>,
+        position: &[u32],
+        buffers: &mut UpdateBuffers,
+    ) {
         let (up, down) = (self.plan.updater_ptr[s], self.plan.updater_ptr[s + 1]);
-        if up == down {
-            return;
-        }
-        let (_, width, _, pattern) = self.shape(s);
-        let begin = self.sym.supernode_begin()[s];
-        let position = &mut scratch.position;
-        position.resize(self.sym.nrows(), 0);
-        // Fits: the plan checked n ≤ u32::MAX.
-        for (k, r) in (begin..begin + width)
-            .chain(pattern.iter().copied())
-            .enumerate()
-        {
-            position[r] = k as u32;
-        }
         for &d in &self.plan.updaters[up..down] {
-            self.update(l.rb_mut(), s, d as usize, cols.clone(), scratch);
+            self.update(l.rb_mut(), s, d as usize, cols.clone(), position, buffers);
         }
     }
 
@@ -557,7 +563,8 @@ impl<'a> Context<'a> {
         s: usize,
         d: usize,
         cols: Range<usize>,
-        scratch: &mut Scratch,
+        position: &[u32],
+        buffers: &mut UpdateBuffers,
     ) {
         let (range, d_width, d_rows, d_pattern) = self.shape(d);
         let begin = self.sym.supernode_begin()[s];
@@ -569,9 +576,9 @@ impl<'a> Context<'a> {
             return;
         }
         // Their positions in s (d's pattern from s on lies in s's columns and pattern).
-        let local = &mut scratch.local;
+        let local = &mut buffers.local;
         local.clear();
-        local.extend(rows.iter().map(|&r| scratch.position[r] as usize));
+        local.extend(rows.iter().map(|&r| position[r] as usize));
         // SAFETY: d is a descendant of s, whose task ended before this one started.
         let ld =
             MatRef::from_column_major_slice(unsafe { self.values.block(range) }, d_rows, d_width);
@@ -584,14 +591,14 @@ impl<'a> Context<'a> {
             product(dst, below, mid, Accum::Add);
             return;
         }
-        if scratch.update.len() < n * m {
-            scratch.update.resize(n * m, 0.0);
+        if buffers.update.len() < n * m {
+            buffers.update.resize(n * m, 0.0);
         }
-        let w = MatMut::from_column_major_slice_mut(&mut scratch.update[..n * m], n, m);
+        let w = MatMut::from_column_major_slice_mut(&mut buffers.update[..n * m], n, m);
         product(w, below, mid, Accum::Replace);
         // Scatter the lower trapezoid of the product: column j of it goes to s's column
         // local[j], its rows i ≥ j to rows local[i].
-        let w = &scratch.update[..n * m];
+        let w = &buffers.update[..n * m];
         let stride = l.col_stride() as usize;
         let (lrows, lcols) = (l.nrows(), l.ncols());
         let dst = l.as_ptr_mut();
