@@ -257,6 +257,7 @@ impl LinearSolver for ConjugateGradient {
             n: a.ncols(),
             nnz_a: a.nnz(),
             nnz_factor: None,
+            factor_bytes: None,
             flops: None,
             ordering: "none".into(),
         })

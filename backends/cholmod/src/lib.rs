@@ -204,7 +204,7 @@ impl LinearSolver for Cholmod {
         let mut header = state.header();
         // SAFETY: `c` is a started common; the header points to live arrays of the declared
         // sizes; `perm` (if any) has n entries.
-        let (factor, status, lnz, fl) = unsafe {
+        let (factor, status, lnz, fl, stored) = unsafe {
             (*c).nmethods = nmethods;
             (*c).method[0].ordering = method as c_int;
             (*c).postorder = 1;
@@ -212,7 +212,13 @@ impl LinearSolver for Cholmod {
                 .as_mut()
                 .map_or(std::ptr::null_mut(), |p| p.as_mut_ptr());
             let f = ss::cholmod_l_analyze_p(&mut header, pp, std::ptr::null_mut(), 0, c);
-            (f, (*c).status, (*c).lnz, (*c).fl)
+            // A supernodal symbolic factor knows its values' size (relaxed zeros included);
+            // a simplicial one stores its structure.
+            let stored = match f.as_ref() {
+                Some(l) if l.is_super != 0 => l.xsize as f64,
+                _ => (*c).lnz,
+            };
+            (f, (*c).status, (*c).lnz, (*c).fl, stored)
         };
         if factor.is_null() || status < 0 {
             return Err(backend_error(status, "cholmod_l_analyze_p"));
@@ -223,6 +229,7 @@ impl LinearSolver for Cholmod {
             n,
             nnz_a: a.nnz(),
             nnz_factor: Some(lnz as usize),
+            factor_bytes: Some(8 * stored as usize),
             flops: Some(fl),
             ordering: name.to_string(),
         })

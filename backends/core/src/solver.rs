@@ -32,8 +32,12 @@ pub struct AnalyzeInfo {
     pub n: usize,
     /// Stored entries of A (both triangles).
     pub nnz_a: usize,
-    /// Entries of the factor L (or L + U), when a direct method.
+    /// Entries of the factor L (or L + U) by its structure, when a direct method: the figure
+    /// to compare orderings and backends by (CHOLMOD's `lnz`).
     pub nnz_factor: Option<usize>,
+    /// Bytes of the factor's values as stored, when known: a supernodal factor also stores
+    /// the explicit zeros of its relaxed supernodes.
+    pub factor_bytes: Option<usize>,
     /// Floating point operations of one numeric factorization, when known.
     pub flops: Option<f64>,
     /// The ordering that was used.

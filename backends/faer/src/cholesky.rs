@@ -22,9 +22,9 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use fibercell_solver::{
-    compute_ordering, AnalyzeInfo, Capabilities, CscRef, FillOrdering, ForwardColumns,
-    LinearSolver, LowerTriangle, NodeGraph, PatternFingerprint, Permutation, SolveInfo,
-    SolverError,
+    compute_ordering, AnalyzeInfo, Capabilities, CscRef, FillEstimate, FillOrdering,
+    ForwardColumns, LinearSolver, LowerTriangle, NodeGraph, PatternFingerprint, Permutation,
+    SolveInfo, SolverError,
 };
 use std::sync::Arc;
 
@@ -198,18 +198,22 @@ impl FaerCholesky {
 
     /// The fill-reducing permutation of `a` (checked structurally symmetric) and its name.
     /// AMD and nested dissection run on the node graph; Auto takes the one with fewer flops
-    /// predicted there, so only the winner gets a scalar symbolic factorization.
-    fn permutation(&self, a: CscRef<'_>) -> Result<(Permutation, String), SolverError> {
+    /// predicted there, so only the winner gets a scalar symbolic factorization. The fill of an
+    /// ordering computed on the node graph is the factor's exact structure.
+    fn permutation(
+        &self,
+        a: CscRef<'_>,
+    ) -> Result<(Permutation, String, Option<FillEstimate>), SolverError> {
         match &self.ordering {
             o @ (FillOrdering::Auto | FillOrdering::Amd | FillOrdering::NestedDissection) => {
-                let (p, _, chosen) = NodeGraph::of_checked(a).order(o)?;
+                let (p, fill, chosen) = NodeGraph::of_checked(a).order(o)?;
                 let name = match o {
                     FillOrdering::Auto => format!("auto→{}", chosen.name()),
                     o => o.name().to_string(),
                 };
-                Ok((p, name))
+                Ok((p, name, Some(fill)))
             }
-            o => Ok((compute_ordering(a, o)?, o.name().to_string())),
+            o => Ok((compute_ordering(a, o)?, o.name().to_string(), None)),
         }
     }
 
@@ -267,7 +271,7 @@ impl LinearSolver for FaerCholesky {
         let n = a.ncols();
         // The lower triangle is extracted while the ordering runs (METIS is sequential).
         let (lower_tri, ordered) = rayon::join(|| LowerTriangle::of(a), || self.permutation(a));
-        let (perm, name) = ordered?;
+        let (perm, name, fill) = ordered?;
         let lower = SymbolicSparseColMatRef::new_checked(
             n,
             n,
@@ -276,12 +280,15 @@ impl LinearSolver for FaerCholesky {
             &lower_tri.row_idx,
         );
         let symbolic = self.symbolic_for(lower, &perm)?;
-        let (nnz_l, flops) = fill_and_flops(&symbolic);
+        // faer's supernodes store explicit zeros where they were relaxed; nnz(L) and the
+        // flops are the structure's (from the node graph, else faer's column counts).
+        let (nnz_l, flops) = fill.map_or_else(|| fill_and_flops(&symbolic), |f| (f.nnz_l, f.flops));
         let tree = BlockTree::of(&symbolic);
         let info = AnalyzeInfo {
             n,
             nnz_a: a.nnz(),
             nnz_factor: Some(nnz_l),
+            factor_bytes: Some(8 * symbolic.len_val()),
             flops: Some(flops),
             ordering: name,
         };
@@ -631,6 +638,36 @@ mod tests {
         let mut x = b.to_vec();
         solver.solve_in_place(&mut x, 1).unwrap();
         x
+    }
+
+    /// nnz(L) is the factor's structure (its entries on and below the diagonal that are not
+    /// exactly zero: a relaxed supernode's explicit zeros receive no update and stay 0.0), the
+    /// stored bytes its values with those zeros, as CHOLMOD counts `lnz` and `xsize`.
+    #[test]
+    fn nnz_counts_the_structure_and_bytes_the_stored_values() {
+        let a = grid(14);
+        let mut s = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::NestedDissection);
+        let info = s.analyze(a.as_ref()).unwrap();
+        s.factorize(a.as_ref()).unwrap();
+        assert_eq!(s.is_supernodal(), Some(true));
+        let view = s.factor_view();
+        let SymbolicCholeskyRaw::Supernodal(sn) = view.symbolic.raw() else {
+            unreachable!("checked supernodal")
+        };
+        let (mut structural, mut lower) = (0, 0);
+        for (b, e, rows, start) in crate::pivots::supernodes(sn) {
+            for c in 0..e - b {
+                let column = &view.values[start + c * rows + c..start + (c + 1) * rows];
+                structural += column.iter().filter(|&&v| v != 0.0).count();
+                lower += column.len();
+            }
+        }
+        assert_eq!(info.nnz_factor, Some(structural));
+        assert_eq!(info.factor_bytes, Some(8 * view.values.len()));
+        assert!(
+            lower > structural,
+            "no relaxed zeros: the test shows nothing"
+        );
     }
 
     /// A shared solver solves bit for bit as its origin (one and several right-hand sides,

@@ -168,6 +168,7 @@ impl LinearSolver for FaerLu {
             n,
             nnz_a: a.nnz(),
             nnz_factor: None,
+            factor_bytes: None,
             flops: None,
             ordering: "colamd".into(),
         })

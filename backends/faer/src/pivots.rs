@@ -7,7 +7,9 @@ use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 type SupernodalSymbolic = SymbolicSupernodalCholesky<usize>;
 
 /// Each supernode as (first column, end column, rows of its dense block, first value index).
-fn supernodes(s: &SupernodalSymbolic) -> impl Iterator<Item = (usize, usize, usize, usize)> + '_ {
+pub(crate) fn supernodes(
+    s: &SupernodalSymbolic,
+) -> impl Iterator<Item = (usize, usize, usize, usize)> + '_ {
     (0..s.n_supernodes()).map(move |k| {
         let (b, e) = (s.supernode_begin()[k], s.supernode_end()[k]);
         let below = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];

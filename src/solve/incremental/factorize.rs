@@ -92,7 +92,7 @@ impl StickSlip<'_, '_, '_> {
             .build()?;
             let info = s.analyze(a).map_err(locate)?;
             if !nonsymmetric {
-                factors.factor_bytes = info.nnz_factor.map(|nnz| 8 * nnz);
+                factors.factor_bytes = info.factor_bytes;
             }
             *slot = Some(s);
         }

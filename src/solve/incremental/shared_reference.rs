@@ -60,7 +60,7 @@ impl SharedReference {
         Ok(Some(SharedReference {
             blocks: reference_blocks(setup, &rest.contacts),
             factorize_seconds: started.elapsed().as_secs_f64(),
-            factor_bytes: info.nnz_factor.map(|nnz| 8 * nnz),
+            factor_bytes: info.factor_bytes,
             values: Arc::new(values),
             solver: Mutex::new(solver),
         }))

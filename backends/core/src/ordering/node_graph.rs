@@ -120,6 +120,7 @@ impl NodeGraph {
                 )))
             }
         };
+        let nodes = self.postordered(&nodes);
         let fill = self.fill(&nodes);
         Ok((self.expand(&nodes)?, fill, ordering.clone()))
     }
@@ -144,7 +145,7 @@ impl NodeGraph {
                 }
             }
         };
-        Ok((self.expand(&nodes)?, fill, chosen))
+        Ok((self.expand(&self.postordered(&nodes))?, fill, chosen))
     }
 
     /// The scalar permutation of a node order (`nodes[new] = old node`): each node's columns
@@ -203,6 +204,25 @@ impl NodeGraph {
     /// j. Node j of width w with b unknowns below its block then has scalar column counts
     /// w + b, w − 1 + b, …, 1 + b. O(nnz of the node factor).
     pub fn fill(&self, nodes: &[usize]) -> FillEstimate {
+        let (_, below) = self.tree_and_counts(nodes);
+        let mut fill = FillEstimate {
+            nnz_l: 0,
+            flops: 0.0,
+        };
+        for (j, &old) in nodes.iter().enumerate() {
+            let b = below[j];
+            for k in 1..=self.weight(old) {
+                let c = k + b;
+                fill.nnz_l += c;
+                fill.flops += (c as f64) * (c as f64);
+            }
+        }
+        fill
+    }
+
+    /// The elimination tree of the permuted node graph (`parent`, a root its own parent) and
+    /// each node's unknowns below its diagonal block in L (`below`), by position.
+    fn tree_and_counts(&self, nodes: &[usize]) -> (Vec<usize>, Vec<usize>) {
         let m = self.nodes();
         let mut position = vec![0usize; m];
         for (new, &old) in nodes.iter().enumerate() {
@@ -226,19 +246,47 @@ impl NodeGraph {
                 }
             }
         }
-        let mut fill = FillEstimate {
-            nnz_l: 0,
-            flops: 0.0,
-        };
-        for (j, &old) in nodes.iter().enumerate() {
-            let b = below[j];
-            for k in 1..=self.weight(old) {
-                let c = k + b;
-                fill.nnz_l += c;
-                fill.flops += (c as f64) * (c as f64);
+        (parent, below)
+    }
+
+    /// An equivalent node order (same elimination tree, same fill): the tree's postorder with
+    /// each node's children by ascending column count, so the child with the longest column
+    /// comes right before its parent (CHOLMOD's weighted postorder). A supernode can absorb
+    /// only the supernode numbered right before it, so this is the order in which relaxed
+    /// amalgamation merges the most.
+    pub fn postordered(&self, nodes: &[usize]) -> Vec<usize> {
+        let m = nodes.len();
+        let (parent, below) = self.tree_and_counts(nodes);
+        let count = |j: usize| below[j] + self.weight(nodes[j]);
+        // Children lists, each by ascending count (a stable sort of the positions by count,
+        // then pushed onto the lists in reverse so each list is read in ascending order).
+        let mut by_count: Vec<usize> = (0..m).collect();
+        by_count.sort_by_key(|&j| count(j));
+        let mut head = vec![usize::MAX; m];
+        let mut next = vec![usize::MAX; m];
+        for &j in by_count.iter().rev() {
+            let p = parent[j];
+            if p != j {
+                next[j] = head[p];
+                head[p] = j;
             }
         }
-        fill
+        let mut out = Vec::with_capacity(m);
+        let mut stack = Vec::new();
+        for root in (0..m).filter(|&j| parent[j] == j) {
+            stack.push(root);
+            while let Some(&j) = stack.last() {
+                let c = head[j];
+                if c == usize::MAX {
+                    out.push(nodes[j]);
+                    stack.pop();
+                } else {
+                    head[j] = next[c];
+                    stack.push(c);
+                }
+            }
+        }
+        out
     }
 
     /// Parent of each node in the elimination tree of the permuted node graph (Liu's algorithm
@@ -394,6 +442,59 @@ mod tests {
         }
         assert_eq!(fill.flops, best);
         assert_eq!(scalar_fill(&a, &p), fill);
+    }
+
+    /// The postorder is an equivalent order (same fill, by faer's scalar column counts) in
+    /// which every subtree is contiguous and ends at its root, and the child right before
+    /// each parent has the longest column of its siblings (so faer's relaxed amalgamation,
+    /// which merges only that child, can merge the widest one).
+    #[test]
+    fn the_postorder_keeps_the_fill_and_puts_the_longest_child_last() {
+        for m in [1, 17, 200] {
+            let a = scattered(m);
+            let g = NodeGraph::of(a.as_ref()).unwrap();
+            let k = g.nodes();
+            for nodes in [(0..k).collect::<Vec<_>>(), g.amd().unwrap()] {
+                let post = g.postordered(&nodes);
+                let p = g.expand(&post).unwrap();
+                assert_eq!(scalar_fill(&a, &p), g.fill(&nodes), "m = {m}");
+                let (parent, below) = g.tree_and_counts(&post);
+                let count = |j: usize| below[j] + g.weight(post[j]);
+                let mut size = vec![1usize; k];
+                let mut longest_child = vec![None::<usize>; k];
+                for j in 0..k {
+                    let q = parent[j];
+                    if q == j {
+                        continue;
+                    }
+                    assert!(q > j, "m = {m}: parent before child");
+                    size[q] += size[j];
+                    if longest_child[q].is_none_or(|c| count(c) <= count(j)) {
+                        longest_child[q] = Some(j);
+                    }
+                }
+                for j in 0..k {
+                    // Subtree of j: the size[j] positions ending at j.
+                    let first = j + 1 - size[j];
+                    for d in first..j {
+                        let mut r = d;
+                        while parent[r] != r && r < j {
+                            r = parent[r];
+                        }
+                        assert_eq!(r, j, "m = {m}: position {d} outside the subtree of {j}");
+                    }
+                    if j > 0 && parent[j - 1] == j {
+                        let c = longest_child[j].unwrap();
+                        assert_eq!(count(j - 1), count(c), "m = {m}: a longer child not last");
+                    } else {
+                        assert!(
+                            longest_child[j].is_none(),
+                            "m = {m}: child not right before"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]
