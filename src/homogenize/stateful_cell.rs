@@ -272,3 +272,30 @@ fn along(direction: &MacroStrain, increment: &MacroStrain) -> Option<f64> {
         .all(|j| (increment[j] - s * direction[j]).abs() <= 1e-14 * scale)
         .then_some(s)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// A state on the cell's shared rest factorization counts that factor's size in its
+    /// memory rule (a second factor beside the reference only while it is at most
+    /// `MAX_BESIDE_FACTOR_BYTES`): after its first update at rest (it solves on the shared
+    /// factor), and after its caches were released (it adopts the shared factor).
+    #[test]
+    fn states_count_the_shared_factors_size() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/cells/nonwoven_small.toml");
+        let model = crate::io::load_model(&path).expect("fixture loads");
+        let cell = Cell::new(&model, &IncrementalOptions::default()).expect("the cell sets up");
+        let shared = cell.setup.shared_factor_bytes();
+        assert!(shared.is_some_and(|b| b > 0), "{shared:?}");
+        let mut state = cell.new_state();
+        let step = [1e-4, 0.0, 0.0, 0.0, 0.0, 0.0];
+        cell.update(&mut state, &step).expect("update at rest");
+        assert_eq!(state.run.factor_bytes(), shared);
+        state.release_caches();
+        cell.update(&mut state, &step)
+            .expect("update after the release");
+        assert_eq!(state.run.factor_bytes(), shared);
+    }
+}

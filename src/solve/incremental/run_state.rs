@@ -48,6 +48,12 @@ impl Clone for RunState {
 }
 
 impl RunState {
+    /// The bytes of the symmetric factor its memory rules count with (tests).
+    #[cfg(test)]
+    pub(crate) fn factor_bytes(&self) -> Option<usize> {
+        self.factors.factor_bytes
+    }
+
     /// At rest: every closed contact in stick, no slip, on the setup's own load path.
     pub fn start(setup: &Setup<'_>) -> Self {
         StickSlip::new(setup, None).park(0.0, 0)

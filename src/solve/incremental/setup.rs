@@ -181,6 +181,12 @@ impl<'a> Setup<'a> {
         Ok(())
     }
 
+    /// The bytes of the shared rest factor's values, when there is one (tests).
+    #[cfg(test)]
+    pub(crate) fn shared_factor_bytes(&self) -> Option<usize> {
+        self.shared.as_ref().and_then(|s| s.factor_bytes())
+    }
+
     /// Writes K of the elements into `values` (resized to the pattern's slots): the kept
     /// copy, or filled anew.
     pub fn elastic_values(&self, values: &mut Vec<f64>) -> Result<(), Error> {
