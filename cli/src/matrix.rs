@@ -51,8 +51,12 @@ pub(crate) fn solve_matrix(
     );
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3e}"));
     println!(
-        "nnz(L) {}, flops {}, iterations {}",
+        "nnz(L) {}{}, flops {}, iterations {}",
         r.nnz_factor.map_or("-".to_string(), |v| v.to_string()),
+        r.factor_bytes.map_or(String::new(), |b| format!(
+            " ({:.1} MB stored)",
+            b as f64 / 1e6
+        )),
         opt(r.flops),
         r.iterations.map_or("-".to_string(), |v| v.to_string())
     );

@@ -619,6 +619,12 @@ fn solve_matrix_reads_what_export_matrix_writes() {
             .as_f64()
             .expect("error against ones");
         assert!(be <= 1e-12 && ones <= 1e-8, "{solver}: {be:e} {ones:e}");
+        // A 29-unknown matrix gets faer's simplicial factor: its stored values are its
+        // structure, 8 bytes each. LU and CG report no factor size.
+        match (doc["nnz_factor"].as_u64(), doc["factor_bytes"].as_u64()) {
+            (Some(nnz), Some(bytes)) if solver == "faer-cholesky" => assert_eq!(bytes, 8 * nnz),
+            (_, bytes) => assert!(solver != "faer-cholesky" && bytes.is_none(), "{solver}"),
+        }
     }
     let bad = dir.join("bad.mtx");
     std::fs::write(

@@ -18,8 +18,10 @@ pub struct MatrixSolveReport {
     pub n: usize,
     /// Stored entries of the matrix (both triangles).
     pub nnz: usize,
-    /// Entries of the factor, when a direct method.
+    /// Entries of the factor by its structure, when a direct method.
     pub nnz_factor: Option<usize>,
+    /// Bytes of the factor's values as stored (relaxed supernodes' zeros included), when known.
+    pub factor_bytes: Option<usize>,
     /// Flops of one numeric factorization, when known.
     pub flops: Option<f64>,
     /// Iterations, for CG.
@@ -91,6 +93,7 @@ pub fn solve_matrix(
             n,
             nnz: a.nnz(),
             nnz_factor: info.nnz_factor,
+            factor_bytes: info.factor_bytes,
             flops: info.flops,
             iterations: report.info.iterations,
             repeats,
