@@ -215,8 +215,8 @@ impl LinearSolver for Cholmod {
             // A supernodal symbolic factor knows its values' size (relaxed zeros included);
             // a simplicial one stores its structure.
             let stored = match f.as_ref() {
-                Some(l) if l.is_super != 0 => l.xsize as f64,
-                _ => (*c).lnz,
+                Some(l) if l.is_super != 0 => l.xsize,
+                _ => (*c).lnz as usize,
             };
             (f, (*c).status, (*c).lnz, (*c).fl, stored)
         };
@@ -229,7 +229,7 @@ impl LinearSolver for Cholmod {
             n,
             nnz_a: a.nnz(),
             nnz_factor: Some(lnz as usize),
-            factor_bytes: Some(8 * stored as usize),
+            factor_bytes: Some(8 * stored),
             flops: Some(fl),
             ordering: name.to_string(),
         })
