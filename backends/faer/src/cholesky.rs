@@ -279,7 +279,13 @@ impl LinearSolver for FaerCholesky {
             None,
             &lower_tri.row_idx,
         );
-        let symbolic = self.symbolic_for(lower, &perm)?;
+        // faer keeps a custom ordering as it is, so the triangle in the factor's order is
+        // built while faer's symbolic factorization runs (sequential).
+        let (symbolic, permuted) = rayon::join(
+            || self.symbolic_for(lower, &perm),
+            || lower_tri.permuted(&perm.inv),
+        );
+        let symbolic = symbolic?;
         // faer's supernodes store explicit zeros where they were relaxed; nnz(L) and the
         // flops are the structure's (from the node graph, else faer's column counts).
         let (nnz_l, flops) = fill.map_or_else(|| fill_and_flops(&symbolic), |f| (f.nnz_l, f.flops));
@@ -302,10 +308,11 @@ impl LinearSolver for FaerCholesky {
             }
             _ => None,
         };
+        debug_assert_eq!(factor_inv, perm.inv);
         let lower_tri = if is_simplicial(&symbolic) {
             lower_tri
         } else {
-            lower_tri.permuted(&factor_inv)
+            permuted
         };
         self.analysis = Some(Arc::new(Analysis {
             n,
