@@ -6,6 +6,7 @@
 pub use crate::error::PatternTooLargeError;
 use crate::model::Model;
 use fibercell_solver::{CscRef, SolverError};
+use rayon::prelude::*;
 
 /// Slot of a block-matrix entry that touches a prescribed DOF.
 pub const NO_SLOT: u32 = u32::MAX;
@@ -57,53 +58,73 @@ impl Pattern {
                 adjacency[p].extend_from_slice(b);
             }
         }
-        for adj in &mut adjacency {
+        adjacency.par_iter_mut().for_each(|adj| {
             adj.sort_unstable();
             adj.dedup();
-        }
+        });
+        let free = |node: usize| {
+            red[6 * node..6 * node + 6]
+                .iter()
+                .filter(|&&r| r != usize::MAX)
+        };
+        // Every free DOF of a node has the same rows: its neighbours' free DOFs, ascending.
+        let rows_of_node: Vec<usize> = adjacency
+            .par_iter()
+            .map(|adj| adj.iter().map(|&nb| free(nb).count()).sum())
+            .collect();
         let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
         col_ptr.push(0);
-        for node in 0..n_nodes {
-            for d in 0..6 {
-                if red[6 * node + d] == usize::MAX {
-                    continue;
-                }
-                for &nb in &adjacency[node] {
-                    row_idx.extend(red[6 * nb..6 * nb + 6].iter().filter(|&&r| r != usize::MAX));
-                }
-                col_ptr.push(row_idx.len());
+        for (node, &rows) in rows_of_node.iter().enumerate() {
+            for _ in free(node) {
+                col_ptr.push(col_ptr[col_ptr.len() - 1] + rows);
             }
         }
-        if row_idx.len() >= NO_SLOT as usize {
-            return Err(PatternTooLargeError(row_idx.len()));
+        let nnz = col_ptr[col_ptr.len() - 1];
+        if nnz >= NO_SLOT as usize {
+            return Err(PatternTooLargeError(nnz));
         }
-        // Grown by doubling: up to twice its length (L: 268 MB held for 232 MB of entries).
-        row_idx.shrink_to_fit();
-        let reduced_of = |g: usize| (red[g] != usize::MAX).then_some(red[g]);
-        let mut block_offsets = vec![0];
-        let mut slots =
-            Vec::with_capacity(blocks.iter().map(|b| 36 * b.len() * b.len()).sum::<usize>());
-        for b in blocks {
-            let m = 6 * b.len();
-            let globals: Vec<usize> = b
-                .iter()
-                .flat_map(|&nd| (0..6).map(move |d| 6 * nd + d))
-                .collect();
-            let start = slots.len();
-            slots.resize(start + m * m, NO_SLOT);
-            for (c, &gc) in globals.iter().enumerate() {
-                let Some(jc) = reduced_of(gc) else { continue };
-                let rows = &row_idx[col_ptr[jc]..col_ptr[jc + 1]];
-                for (r, &gr) in globals.iter().enumerate() {
-                    let Some(ir) = reduced_of(gr) else { continue };
-                    if let Ok(k) = rows.binary_search(&ir) {
-                        slots[start + r * m + c] = (col_ptr[jc] + k) as u32;
+        let mut row_idx = vec![0usize; nnz];
+        let node_entries = (0..n_nodes).map(|node| free(node).count() * rows_of_node[node]);
+        split_by_lengths(&mut row_idx, node_entries)
+            .into_par_iter()
+            .zip(&adjacency)
+            .for_each(|(out, adj)| {
+                let mut k = 0;
+                while k < out.len() {
+                    for &nb in adj {
+                        for &r in free(nb) {
+                            out[k] = r;
+                            k += 1;
+                        }
                     }
                 }
-            }
-            block_offsets.push(slots.len());
+            });
+        drop(adjacency);
+        let reduced_of = |g: usize| (red[g] != usize::MAX).then_some(red[g]);
+        let mut block_offsets = Vec::with_capacity(blocks.len() + 1);
+        block_offsets.push(0);
+        for b in blocks {
+            block_offsets.push(block_offsets[block_offsets.len() - 1] + 36 * b.len() * b.len());
         }
+        let mut slots = vec![NO_SLOT; block_offsets[blocks.len()]];
+        let block_lengths = blocks.iter().map(|b| 36 * b.len() * b.len());
+        split_by_lengths(&mut slots, block_lengths)
+            .into_par_iter()
+            .zip(blocks)
+            .for_each(|(slots, b)| {
+                let m = 6 * b.len();
+                let globals = || b.iter().flat_map(|&nd| (0..6).map(move |d| 6 * nd + d));
+                for (c, gc) in globals().enumerate() {
+                    let Some(jc) = reduced_of(gc) else { continue };
+                    let rows = &row_idx[col_ptr[jc]..col_ptr[jc + 1]];
+                    for (r, gr) in globals().enumerate() {
+                        let Some(ir) = reduced_of(gr) else { continue };
+                        if let Ok(k) = rows.binary_search(&ir) {
+                            slots[r * m + c] = (col_ptr[jc] + k) as u32;
+                        }
+                    }
+                }
+            });
         let checked = CscRef::check_pattern(n, n, &col_ptr, &row_idx).is_ok();
         Ok(Pattern {
             checked,
@@ -182,4 +203,16 @@ impl Pattern {
             CscRef::new(self.n, self.n, &self.col_ptr, &self.row_idx, values)
         }
     }
+}
+
+/// `v` cut into consecutive pieces of the given lengths (which must add up to at most its
+/// length), for filling them on several threads.
+fn split_by_lengths<T>(mut v: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut pieces = Vec::new();
+    for len in lengths {
+        let (piece, rest) = std::mem::take(&mut v).split_at_mut(len);
+        pieces.push(piece);
+        v = rest;
+    }
+    pieces
 }
