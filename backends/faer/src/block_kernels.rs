@@ -216,18 +216,9 @@ pub(crate) fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>
     below.clear();
     below.resize(b.pattern.len(), 0.0);
     if b.values.len() >= DENSE_KERNEL_VALUES {
-        let (l_top, l_bottom) =
-            MatRef::from_column_major_slice(b.values, ld, b.width).split_at_row(b.width);
-        let mut x = MatMut::from_column_major_slice_mut(top, b.width, 1);
-        solve_lower_triangular_in_place(l_top, x.rb_mut(), par);
-        matmul(
-            MatMut::from_column_major_slice_mut(below, b.pattern.len(), 1),
-            Accum::Replace,
-            l_bottom,
-            x.rb(),
-            1.0,
-            par,
-        );
+        let x = MatMut::from_column_major_slice_mut(top, b.width, 1);
+        let below = MatMut::from_column_major_slice_mut(below, b.pattern.len(), 1);
+        forward_dense(b, x, below, par);
         return;
     }
     for c in 0..b.width {
@@ -248,18 +239,9 @@ pub(crate) fn forward_block(b: &Block<'_>, top: &mut [f64], below: &mut Vec<f64>
 pub(crate) fn backward_block(b: &Block<'_>, top: &mut [f64], below: &[f64], par: Par) {
     let ld = b.width + b.pattern.len();
     if b.values.len() >= DENSE_KERNEL_VALUES {
-        let (l_top, l_bottom) =
-            MatRef::from_column_major_slice(b.values, ld, b.width).split_at_row(b.width);
-        let mut x = MatMut::from_column_major_slice_mut(top, b.width, 1);
-        matmul(
-            x.rb_mut(),
-            Accum::Add,
-            l_bottom.transpose(),
-            MatRef::from_column_major_slice(below, b.pattern.len(), 1),
-            -1.0,
-            par,
-        );
-        solve_upper_triangular_in_place(l_top.transpose(), x, par);
+        let x = MatMut::from_column_major_slice_mut(top, b.width, 1);
+        let below = MatRef::from_column_major_slice(below, b.pattern.len(), 1);
+        backward_dense(b, x, below, par);
         return;
     }
     for c in (0..b.width).rev() {
@@ -267,6 +249,43 @@ pub(crate) fn backward_block(b: &Block<'_>, top: &mut [f64], below: &[f64], par:
         let sum = dot(&col[c + 1..b.width], &top[c + 1..]) + dot(&col[b.width..], below);
         top[c] = (top[c] - sum) / col[c];
     }
+}
+
+/// The forward step of one block by faer's kernels on the block's rows `x` (width × k, any
+/// layout): x ← L₁₁⁻¹ x and `below` ← L₂₁ x, what its pattern rows lose.
+pub(crate) fn forward_dense(
+    b: &Block<'_>,
+    mut x: MatMut<'_, f64>,
+    below: MatMut<'_, f64>,
+    par: Par,
+) {
+    let ld = b.width + b.pattern.len();
+    let (l_top, l_bottom) =
+        MatRef::from_column_major_slice(b.values, ld, b.width).split_at_row(b.width);
+    solve_lower_triangular_in_place(l_top, x.rb_mut(), par);
+    matmul(below, Accum::Replace, l_bottom, x.rb(), 1.0, par);
+}
+
+/// The backward step of one block by faer's kernels: x ← L₁₁⁻ᵀ (x − L₂₁ᵀ below), `below` the
+/// final values of its pattern rows.
+pub(crate) fn backward_dense(
+    b: &Block<'_>,
+    mut x: MatMut<'_, f64>,
+    below: MatRef<'_, f64>,
+    par: Par,
+) {
+    let ld = b.width + b.pattern.len();
+    let (l_top, l_bottom) =
+        MatRef::from_column_major_slice(b.values, ld, b.width).split_at_row(b.width);
+    matmul(
+        x.rb_mut(),
+        Accum::Add,
+        l_bottom.transpose(),
+        below,
+        -1.0,
+        par,
+    );
+    solve_upper_triangular_in_place(l_top.transpose(), x, par);
 }
 
 /// The threads of a top block's kernels: those of `schedule` for the largest blocks (each

@@ -7,6 +7,7 @@
 
 use crate::block_kernels::SolveSchedule;
 use crate::block_solve::{backward_in_place, forward_in_place, solve_in_place as block_solve};
+use crate::block_solve_many::{solve_many_in_place, FactorBlocks};
 use crate::block_tree::{BlockTree, FactorView};
 use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
@@ -541,6 +542,23 @@ impl LinearSolver for FaerCholesky {
             permute::into_factor_order(rhs, &f.scale, &an.factor_fwd, &mut x, true);
             block_solve(&an.tree, &an.schedule, &an.symbolic, &f.l_values, &mut x);
             permute::from_factor_order(&x, &f.scale, &an.factor_inv, rhs, true);
+            self.work = x;
+            return Ok(SolveInfo::default());
+        }
+        if self.variant == CholeskyVariant::Llt && an.schedule.is_parallel() {
+            // Several right-hand sides on a factor split over the threads: all columns through
+            // each block at once (faer's solve reads the factor once per column group).
+            let mut x = std::mem::take(&mut self.work);
+            x.resize(n * nrhs, 0.0);
+            permute::many_into_factor_order(rhs, nrhs, &f.scale, &an.factor_fwd, &mut x);
+            let blocks = FactorBlocks {
+                tree: &an.tree,
+                schedule: &an.schedule,
+                symbolic: &an.symbolic,
+                values: &f.l_values,
+            };
+            solve_many_in_place(blocks, &mut x, nrhs);
+            permute::many_from_factor_order(&x, nrhs, &f.scale, &an.factor_inv, rhs);
             self.work = x;
             return Ok(SolveInfo::default());
         }

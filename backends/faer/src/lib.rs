@@ -31,6 +31,7 @@
 
 mod block_kernels;
 mod block_solve;
+mod block_solve_many;
 mod block_tree;
 mod cholesky;
 mod column_layout;

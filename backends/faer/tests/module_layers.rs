@@ -13,7 +13,7 @@ const LAYERS: &[&[&str]] = &[
     ],
     &["block_kernels", "prefetch", "top_columns"],
     &["dense_forward"],
-    &["block_solve", "sparse_forward"],
+    &["block_solve", "block_solve_many", "sparse_forward"],
     &["cholesky", "lu"],
 ];
 
