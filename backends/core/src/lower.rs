@@ -55,20 +55,40 @@ impl LowerTriangle {
         for j in 0..n {
             col_ptr[j + 1] += col_ptr[j];
         }
+        let nnz = self.nnz();
         let mut next = col_ptr[..n].to_vec();
-        let mut entries = vec![(0usize, 0usize); self.nnz()];
+        let (mut row_idx, mut src) = (vec![0usize; nnz], vec![0usize; nnz]);
         for j in 0..n {
             for k in self.col_ptr[j]..self.col_ptr[j + 1] {
                 let i = self.row_idx[k];
-                let c = column_of(i, j);
-                entries[next[c]] = (inv[i].max(inv[j]), self.src[k]);
-                next[c] += 1;
+                let c = &mut next[column_of(i, j)];
+                row_idx[*c] = inv[i].max(inv[j]);
+                src[*c] = self.src[k];
+                *c += 1;
             }
         }
+        drop(next);
+        // Rows sorted within each column, each entry's source along: a column's pairs go
+        // through a small buffer (no copy of the whole triangle as pairs).
+        let mut pairs = Vec::new();
         for j in 0..n {
-            entries[col_ptr[j]..col_ptr[j + 1]].sort_unstable();
+            let column = col_ptr[j]..col_ptr[j + 1];
+            if row_idx[column.clone()].is_sorted() {
+                continue;
+            }
+            pairs.clear();
+            pairs.extend(
+                row_idx[column.clone()]
+                    .iter()
+                    .copied()
+                    .zip(src[column.clone()].iter().copied()),
+            );
+            pairs.sort_unstable();
+            for (k, &(row, from)) in column.zip(&pairs) {
+                row_idx[k] = row;
+                src[k] = from;
+            }
         }
-        let (row_idx, src) = entries.into_iter().unzip();
         LowerTriangle {
             col_ptr,
             row_idx,
