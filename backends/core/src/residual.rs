@@ -128,43 +128,17 @@ pub fn solve_checked(
     ))
 }
 
-/// A X for the `nrhs` columns of `x` (length n each): the columns in groups, one group per
-/// thread, each group reading A once with its columns interleaved (one cache line per row for
-/// all of them). Every entry is summed by one task in column order, as [`CscRef::mul_vec`]
-/// sums it, so the result does not depend on the threads.
+/// A X for the `nrhs` columns of `x` (length n each), the columns on all threads, each by
+/// [`CscRef::mul_vec`] (so the result does not depend on the threads).
 fn products(a: CscRef<'_>, x: &[f64], nrhs: usize) -> Vec<f64> {
     let (m, n) = (a.nrows(), a.ncols());
     let mut ax = vec![0.0; m * nrhs];
-    if nrhs == 0 || m == 0 || n == 0 {
+    if m == 0 || n == 0 {
         return ax;
     }
-    let groups = rayon::current_num_threads().clamp(1, nrhs);
-    let per_group = nrhs.div_ceil(groups);
-    ax.par_chunks_mut(per_group * m)
-        .zip(x.par_chunks(per_group * n))
-        .for_each(|(y, x)| {
-            let k = x.len() / n;
-            let mut xi = vec![0.0; n * k];
-            for (c, xc) in x.chunks(n).enumerate() {
-                for (j, &v) in xc.iter().enumerate() {
-                    xi[j * k + c] = v;
-                }
-            }
-            let mut yi = vec![0.0; m * k];
-            for (j, xj) in xi.chunks(k).enumerate() {
-                let (rows, vals) = a.col(j);
-                for (&i, &v) in rows.iter().zip(vals) {
-                    for (t, &s) in yi[i * k..(i + 1) * k].iter_mut().zip(xj) {
-                        *t += v * s;
-                    }
-                }
-            }
-            for (c, yc) in y.chunks_mut(m).enumerate() {
-                for (i, t) in yc.iter_mut().enumerate() {
-                    *t = yi[i * k + c];
-                }
-            }
-        });
+    ax.par_chunks_mut(m)
+        .zip(x.par_chunks(n))
+        .for_each(|(y, x)| a.mul_vec(x, y));
     ax
 }
 
@@ -173,9 +147,8 @@ mod tests {
     use super::*;
     use crate::CscMatrix;
 
-    /// The grouped product of five right-hand sides with a nonsymmetric 3×3 matrix is the
-    /// product worked by hand, on one, two and three threads (groups of 5, 3 + 2 and 2 + 2 + 1
-    /// columns).
+    /// The product of five right-hand sides with a nonsymmetric 3×3 matrix is the product
+    /// worked by hand, on one, two and three threads.
     #[test]
     fn products_of_several_columns_are_each_columns_product_on_any_threads() {
         // A = [[2, 0, 1], [0, 3, 0], [4, 0, 5]], stored column by column.
