@@ -547,9 +547,9 @@ impl LinearSolver for FaerCholesky {
         }
         if self.variant == CholeskyVariant::Llt && an.schedule.is_parallel() {
             // Several right-hand sides on a factor split over the threads: all columns through
-            // each block at once (faer's solve reads the factor once per column group).
-            let mut x = std::mem::take(&mut self.work);
-            x.resize(n * nrhs, 0.0);
+            // each block at once (faer's solve reads the factor once per column group). The
+            // buffer is not kept: shared solvers of many material points would each hold one.
+            let mut x = vec![0.0; n * nrhs];
             permute::many_into_factor_order(rhs, nrhs, &f.scale, &an.factor_fwd, &mut x);
             let blocks = FactorBlocks {
                 tree: &an.tree,
@@ -559,7 +559,6 @@ impl LinearSolver for FaerCholesky {
             };
             solve_many_in_place(blocks, &mut x, nrhs);
             permute::many_from_factor_order(&x, nrhs, &f.scale, &an.factor_inv, rhs);
-            self.work = x;
             return Ok(SolveInfo::default());
         }
         for col in rhs.chunks_mut(n) {
