@@ -14,7 +14,7 @@ pub enum FillOrdering {
     Natural,
     /// Approximate minimum degree (faer's) on the [`NodeGraph`].
     Amd,
-    /// Nested dissection through METIS `METIS_NodeND` (the best of five separators at each
+    /// Nested dissection through METIS `METIS_NodeND` (the better of two separators at each
     /// level) on the [`NodeGraph`].
     NestedDissection,
     /// A caller's permutation: `perm[new] = old`.

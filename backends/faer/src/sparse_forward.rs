@@ -613,22 +613,33 @@ mod tests {
         let (n, _, s) = grid_factor(16);
         let factor = s.factor_view();
         let tree = BlockTree::of(factor.symbolic);
-        let b = columns(n);
-        let forward =
-            |schedule: &SolveSchedule| tree.forward(&factor, &b, schedule, Par::Seq, None).unwrap();
-        let one = forward(&SolveSchedule::with_threshold(&tree, 1, 0));
+        let forward = |b: &[Vec<(usize, f64)>], schedule: &SolveSchedule| {
+            tree.forward(&factor, b, schedule, Par::Seq, None).unwrap()
+        };
+        let one_group = SolveSchedule::with_threshold(&tree, 1, 0);
         for threads in [2, 3] {
             let schedule = SolveSchedule::with_threshold(&tree, threads, 0);
             assert_eq!(schedule.task_count(), threads);
-            // Both kinds of top columns occur: reached by one task only (written directly)
-            // and by several (the later tasks' parts private).
             let task_of = schedule.task_of(tree.parent.len());
+            let task = |i: usize| task_of[tree.block_of[factor.inv[i]]];
+            // Besides the usual columns, one in a single task's subtrees and one with a row in
+            // every task's, whatever the ordering: both kinds of top columns occur, reached
+            // by one task only (written directly) and by several (the later tasks' parts
+            // private).
+            let first_row_of = |t: usize| (0..n).find(|&i| task(i) == t).expect("task's row");
+            let mut b = columns(n);
+            b.push(vec![(first_row_of(0), 1.5)]);
+            b.push(
+                (0..threads)
+                    .map(|t| (first_row_of(t), 1.0 + t as f64))
+                    .collect(),
+            );
             let reaching: Vec<usize> = b
                 .iter()
                 .map(|col| {
                     let mut tasks: Vec<usize> = col
                         .iter()
-                        .map(|&(i, _)| task_of[tree.block_of[factor.inv[i]]])
+                        .map(|&(i, _)| task(i))
                         .filter(|&t| t != NONE)
                         .collect();
                     tasks.sort_unstable();
@@ -637,11 +648,11 @@ mod tests {
                 })
                 .collect();
             assert!(
-                reaching.contains(&1) && reaching.iter().any(|&k| k > 1),
+                reaching.contains(&1) && reaching.contains(&threads),
                 "{threads} tasks: {reaching:?}"
             );
-            let got = forward(&schedule);
-            assert_same_forward(&got, &one, &format!("{threads} tasks"));
+            let got = forward(&b, &schedule);
+            assert_same_forward(&got, &forward(&b, &one_group), &format!("{threads} tasks"));
         }
     }
 
