@@ -212,9 +212,13 @@ pub(crate) enum Command {
     SolveMatrix {
         /// Matrix Market file of A.
         matrix: PathBuf,
-        /// Matrix Market `array` file of b (default: b = A·1, whose solution is all ones).
+        /// Matrix Market `array` file of B, one or more columns (default: b = A·1, whose
+        /// solution is all ones), e.g. the OUT_rhs.mtx of `export-matrix`.
         #[arg(long)]
         rhs: Option<PathBuf>,
+        /// Write the solution X (Matrix Market `array`, a column per right-hand side).
+        #[arg(short, long, value_name = "FILE")]
+        output: Option<PathBuf>,
         #[command(flatten)]
         solver: SolverArgs,
         /// Run the analysis and the factorization this many times and report their medians

@@ -164,10 +164,18 @@ fn main() -> ExitCode {
         Command::SolveMatrix {
             matrix,
             rhs,
+            output,
             solver,
             repeats,
             json,
-        } => matrix::solve_matrix(&matrix, rhs.as_deref(), &solver, repeats, json),
+        } => matrix::solve_matrix(matrix::SolveMatrixRequest {
+            matrix: &matrix,
+            rhs: rhs.as_deref(),
+            output: output.as_deref(),
+            solver: &solver,
+            repeats,
+            json,
+        }),
         Command::Bench {
             cells,
             json,

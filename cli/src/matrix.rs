@@ -5,13 +5,18 @@ use crate::output::{read_text, to_pretty};
 use fibercell::{io, Error};
 use std::path::Path;
 
-pub(crate) fn solve_matrix(
-    matrix: &Path,
-    rhs: Option<&Path>,
-    solver: &SolverArgs,
-    repeats: usize,
-    json: bool,
-) -> Result<(), Error> {
+/// What `solve-matrix` was asked for.
+pub(crate) struct SolveMatrixRequest<'a> {
+    pub matrix: &'a Path,
+    pub rhs: Option<&'a Path>,
+    pub output: Option<&'a Path>,
+    pub solver: &'a SolverArgs,
+    pub repeats: usize,
+    pub json: bool,
+}
+
+pub(crate) fn solve_matrix(req: SolveMatrixRequest<'_>) -> Result<(), Error> {
+    let matrix = req.matrix;
     let in_file = |path: &Path, e: fibercell::solver::SolverError| {
         Error::Input(io::InputError::Read {
             path: path.display().to_string(),
@@ -20,13 +25,13 @@ pub(crate) fn solve_matrix(
     };
     let a = fibercell::solver::read_matrix_market(&read_text(matrix)?)
         .map_err(|e| in_file(matrix, e))?;
-    let b = match rhs {
+    let b = match req.rhs {
         Some(path) => {
             let (n, k, values) = fibercell::solver::read_matrix_market_dense(&read_text(path)?)
                 .map_err(|e| in_file(path, e))?;
-            if k != 1 || n != a.as_ref().nrows() {
+            if k == 0 || n != a.as_ref().nrows() {
                 return Err(Error::InvalidOption(format!(
-                    "{}: b is {n} × {k}, the matrix needs one column of {}",
+                    "{}: b is {n} × {k}, the matrix needs one or more columns of {}",
                     path.display(),
                     a.as_ref().nrows()
                 )));
@@ -35,17 +40,27 @@ pub(crate) fn solve_matrix(
         }
         None => None,
     };
-    let config = solver.options().solver_config(Vec::new());
-    let (_, r) = fibercell::solve::solve_matrix(a.as_ref(), b.as_deref(), &config, repeats)?;
-    if json {
+    let config = req.solver.options().solver_config(Vec::new());
+    let (x, r) = fibercell::solve::solve_matrix(a.as_ref(), b.as_deref(), &config, req.repeats)?;
+    if let Some(out) = req.output {
+        let comment = format!(
+            "fibercell solve-matrix: X of A X = B for {}",
+            matrix.display()
+        );
+        let text = io::write_matrix_market_dense(r.n, r.columns, &x, &comment);
+        io::write_atomic(out, text.as_bytes())?;
+    }
+    if req.json {
         println!("{}", to_pretty(&r)?);
         return Ok(());
     }
     println!(
-        "{}: n {}, nnz(A) {}, backend {} (ordering {})",
+        "{}: n {}, nnz(A) {}, {} right-hand side{}, backend {} (ordering {})",
         matrix.display(),
         r.n,
         r.nnz,
+        r.columns,
+        if r.columns == 1 { "" } else { "s" },
         r.backend,
         r.ordering
     );
