@@ -273,7 +273,7 @@ impl StickSystem {
     /// All values zero.
     pub fn zero_values(&self) -> PeriodicValues {
         PeriodicValues {
-            values: vec![0.0; self.pattern.nnz()],
+            values: self.pattern.zero_values(),
             couplings: DriverCouplings {
                 coupling: vec![[0.0; 6]; self.discretization.n_free()],
                 k_ee: SMatrix::zeros(),
