@@ -149,16 +149,17 @@ fn factor_cell(
 /// ABD = (K_EE + K_Ef x) / |Y| from the driver couplings and the six cell-problem solutions
 /// x = −K_ff⁻¹ K_fE (columns of length `n`, stacked).
 pub(crate) fn abd_of(couplings: &DriverCouplings, x: &[f64], n: usize, area: f64) -> [[f64; 6]; 6] {
-    let mut abd = [[0.0; 6]; 6];
-    for (j, row) in abd.iter_mut().enumerate() {
-        for (k, v) in row.iter_mut().enumerate() {
-            let schur: f64 = (0..n)
-                .map(|i| couplings.coupling[i][j] * x[k * n + i])
-                .sum();
-            *v = (couplings.k_ee[(j, k)] + schur) / area;
+    // K_Ef x in one pass over the couplings (each sum still in row order).
+    let mut schur = [[0.0; 6]; 6];
+    for (i, c) in couplings.coupling.iter().enumerate().take(n) {
+        for k in 0..6 {
+            let xi = x[k * n + i];
+            for (row, cj) in schur.iter_mut().zip(c) {
+                row[k] += cj * xi;
+            }
         }
     }
-    abd
+    std::array::from_fn(|j| std::array::from_fn(|k| (couplings.k_ee[(j, k)] + schur[j][k]) / area))
 }
 
 /// max |ABD − ABDᵀ| / max |ABD|: zero in exact arithmetic, so the round-off of the moduli.
