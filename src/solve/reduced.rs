@@ -34,7 +34,7 @@ impl ReducedSystem {
         let pattern = Pattern::new(model, dofs.reduced_indices(), dofs.n_free())?;
         let assembler = Assembler::new(model);
         let t1 = Instant::now();
-        let mut values = pattern.zero_values();
+        let mut values = vec![0.0; pattern.nnz()];
         assembler.fill(model, &pattern, &mut values, mode)?;
         let elements = ElementBlocks::new(model, &dofs);
         let rhs = elements.rhs(model, &dofs);

@@ -133,7 +133,7 @@ impl<'a> Setup<'a> {
         let k_elastic = if low_rank_possible {
             None
         } else {
-            let mut k = pattern.zero_values();
+            let mut k = vec![0.0; pattern.nnz()];
             elastic.fill(&model, &pattern, &mut k, opts.solve.fill)?;
             Some(k)
         };
