@@ -3,6 +3,7 @@
 mod affine_reference;
 mod backend;
 mod connectivity;
+mod dense_lu;
 mod gram;
 mod increment_timings;
 mod incremental;
