@@ -2,8 +2,10 @@
 //!
 //! faer's `PartialPivLu::new` copies its input and then splits the factors into two matrices of
 //! the full order, so a capacitance matrix of order R held 3 R² doubles while it was factorized
-//! and 2 R² while it was kept. The L non-woven's curve reaches R ≈ 7,400 (0.44 GB per copy)
-//! right where its memory peaks; this keeps R² throughout, with faer's own kernels.
+//! and 2 R² while it was kept. Capacitances reach orders of thousands (7,456 on the L
+//! non-woven's curve, 0.44 GB per copy); this keeps R² throughout, with faer's own kernels.
+//! The LU serves changes that add springs (slip → stick, the consistent Coulomb tangent); those
+//! that only remove them are factorized by Cholesky in place (`low_rank.rs`).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
