@@ -9,7 +9,8 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
-use faer::perm::PermRef;
+use faer::perm::Perm;
+use faer::reborrow::Reborrow;
 use faer::{MatMut, MatRef};
 
 /// P A = L U of a square matrix, L unit lower and U upper triangular, both in the one
@@ -17,8 +18,8 @@ use faer::{MatMut, MatRef};
 pub struct DenseLu {
     lu: Vec<f64>,
     order: usize,
-    forward: Vec<usize>,
-    inverse: Vec<usize>,
+    /// P, checked once when the factors are made.
+    perm: Perm<usize>,
 }
 
 impl DenseLu {
@@ -31,20 +32,21 @@ impl DenseLu {
         let mut forward = vec![0usize; order];
         let mut inverse = vec![0usize; order];
         let par = faer::get_global_parallelism();
-        let scratch = factor::lu_in_place_scratch::<usize, f64>(order, order, par, default());
+        let scratch =
+            factor::lu_in_place_scratch::<usize, f64>(order, order, par, Default::default());
         factor::lu_in_place(
             MatMut::from_column_major_slice_mut(&mut data, order, order),
             &mut forward,
             &mut inverse,
             par,
             MemStack::new(&mut MemBuffer::new(scratch)),
-            default(),
+            Default::default(),
         );
+        let perm = Perm::new_checked(forward.into(), inverse.into(), order);
         DenseLu {
             lu: data,
             order,
-            forward,
-            inverse,
+            perm,
         }
     }
 
@@ -55,7 +57,6 @@ impl DenseLu {
         let k = rhs.len().checked_div(n).unwrap_or(0);
         assert_eq!(rhs.len(), n * k, "whole columns of right-hand sides");
         let lu = MatRef::from_column_major_slice(&self.lu, n, n);
-        let perm = PermRef::new_checked(&self.forward, &self.inverse, n);
         let par = faer::get_global_parallelism();
         let scratch = solve::solve_in_place_scratch::<usize, f64>(n, k, par);
         // The unit lower solve reads only the strictly lower triangle, the upper solve only
@@ -63,7 +64,7 @@ impl DenseLu {
         solve::solve_in_place(
             lu,
             lu,
-            perm,
+            self.perm.rb(),
             MatMut::from_column_major_slice_mut(rhs, n, k),
             par,
             MemStack::new(&mut MemBuffer::new(scratch)),
@@ -72,12 +73,8 @@ impl DenseLu {
 
     /// The bytes it holds: the factors and the two permutations.
     pub fn memory_bytes(&self) -> usize {
-        8 * self.lu.capacity() + size_of::<usize>() * (self.forward.len() + self.inverse.len())
+        8 * self.lu.capacity() + 2 * size_of::<usize>() * self.order
     }
-}
-
-fn default<T: Default>() -> T {
-    T::default()
 }
 
 #[cfg(test)]

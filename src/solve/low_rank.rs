@@ -503,7 +503,9 @@ impl LowRankCorrection {
     /// by copies as before.
     fn grow_s(&mut self, total: usize) {
         if self.s.col_stride().unsigned_abs() < total {
-            let order = S_RESERVED_ORDER.min(6 * self.owned.len()).max(total);
+            let order = S_RESERVED_ORDER
+                .min(ORDER.len() * self.owned.len())
+                .max(total);
             // Columns a multiple of 4 KiB apart would map a row's entries to one cache set.
             // (faer rounds the rows up to its SIMD alignment, at most 16 doubles.)
             let rows = order.next_multiple_of(16);
