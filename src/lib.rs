@@ -27,6 +27,7 @@ pub mod contact;
 pub mod element;
 pub mod ensemble;
 mod error;
+pub mod free_memory;
 pub mod generate;
 pub mod homogenize;
 mod input_error;

@@ -47,10 +47,14 @@ use crate::Error;
 use std::path::Path;
 
 /// Reads a model file, choosing the format by extension (`.toml`, `.json`, `.inp`), and
-/// validates it.
+/// validates it; the parse's freed memory goes back to the system (see
+/// [`crate::free_memory`]).
 pub fn load_model(path: &Path) -> Result<Model, Error> {
     let desc = read_description(path)?;
-    Ok(Model::from_description(&desc)?)
+    let model = Model::from_description(&desc)?;
+    drop(desc);
+    crate::free_memory::release_free_memory();
+    Ok(model)
 }
 
 /// Reads a model file into its unvalidated description.

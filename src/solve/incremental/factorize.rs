@@ -91,6 +91,8 @@ impl StickSlip<'_, '_, '_> {
             }
             .build()?;
             let info = s.analyze(a).map_err(locate)?;
+            // The ordering's and symbolic factorization's workspace.
+            crate::free_memory::release_free_memory();
             if !nonsymmetric {
                 factors.factor_bytes = info.factor_bytes;
             }
