@@ -150,6 +150,35 @@ fn a_full_store_of_low_rank_columns_refactorizes_and_changes_nothing() {
     refactorizes_more_and_changes_nothing(|o| o.max_low_rank_columns = 6);
 }
 
+/// A store of 8 low-rank columns is full once five contacts slide. Past it, the contacts whose
+/// load alone changed leave U (the assembled load is solved for instead), and a sliding
+/// contact whose slip direction and k⊥ are still near the reference's keeps the reference's
+/// block (modified Newton, see `FrozenTangent`). With the consistent tangent every sliding
+/// contact's block changes in every iteration, a capacitance of order 2 per sliding contact
+/// (Tresca: rank 2 each); frozen, increments solve low-rank at a smaller order (measured: five
+/// sliding contacts at order 4 and 6 in increments 18–20, against 10). The curve is the
+/// default one to 1e-6 of the resultant scale, as in the reuse test above.
+#[test]
+fn sliding_contacts_keep_the_references_tangent_past_a_full_store() {
+    let default = curve(true);
+    let tuned = curve_tuned(|o| o.max_low_rank_columns = 8);
+    let frozen =
+        tuned.solution.increments.iter().filter(|i| {
+            i.slip >= 3 && i.factor_reuses >= 2 && i.low_rank.largest_order < 2 * i.slip
+        });
+    assert!(
+        frozen.count() > 0,
+        "no increment solved sliding contacts on the reference's tangent: {:?}",
+        tuned
+            .solution
+            .increments
+            .iter()
+            .map(|i| (i.slip, i.factor_reuses, i.low_rank.largest_order))
+            .collect::<Vec<_>>()
+    );
+    assert_same_curve(&tuned, &default);
+}
+
 /// Capacitance matrices of order above 4 (more than two changed contacts) are not solved
 /// low-rank: those iterations factorize their matrix directly and the reference factorization
 /// stays for the iterations with fewer changes. The curve is the default one to 1e-6 of the

@@ -44,7 +44,7 @@ const FORWARD_BATCH: usize = 1024;
 
 /// The order S's storage is reserved for when it first grows (see
 /// [`LowRankCorrection::grow_s`]): the default bound on the columns kept on one factorization,
-/// 512 MiB of address space.
+/// 128 MiB of address space.
 const S_RESERVED_ORDER: usize = super::MAX_LOW_RANK_COLUMNS;
 
 /// Products Wᵀ W of one block below this many multiply-adds run single-threaded.
@@ -1169,7 +1169,7 @@ pub(super) mod tests {
         assert_eq!(low_rank.memory_bytes(), 24 * 24 * 8);
     }
 
-    /// The default reservation (8,192 columns) is not laid out 64 KiB apart: columns a multiple
+    /// The default reservation (4,096 columns) is not laid out 32 KiB apart: columns a multiple
     /// of 4 KiB apart map a row's entries to one cache set, and the M curve's S-products by
     /// rows took 20.6–23.5 s against 18.2–20.2 s with the stride off the power of two (three
     /// alternating runs each).

@@ -125,12 +125,8 @@ fn contact_changes(
             let friction = contacts.friction_of(i);
             let stiffness =
                 pairs[i].block_coefficients(&current, friction, setup.stabilization) - r.stiffness;
-            let load = pairs[i].load_coefficients(
-                &current,
-                &contacts.perpendicular[i].1,
-                &contacts.slips[i],
-                friction,
-            ) - pairs[i].load_coefficients(&r.state, &r.anchor, &r.slip, r.friction)
+            let load = contacts.load_coefficients(&pairs[i], i, &current)
+                - r.load(&pairs[i])
                 - stiffness * inc.prescribed_jump[i];
             let change = ContactChange {
                 contact: i,
@@ -163,8 +159,7 @@ impl Scatter<'_, '_> {
             ..contacts.block(i)
         };
         let friction = contacts.friction_of(i);
-        let (anchor, slip) = (&contacts.perpendicular[i].1, &contacts.slips[i]);
-        let mut f = pair.load_of(&pair.load_coefficients(&block_state, anchor, slip, friction));
+        let mut f = pair.load_of(&contacts.load_coefficients(pair, i, &block_state));
         let gdof = |r: usize| 6 * pair.jump.nodes[r / 6] + r % 6;
         let mut prescribed = BlockVector::zeros();
         for &c in &setup.prescribed[i] {
@@ -219,10 +214,8 @@ impl Scatter<'_, '_> {
             // No prescribed DOFs: the load alone, G (φ − φ_base) (see
             // ContactPair::load_coefficients), without the block.
             let pair = &pairs[i];
-            let (anchor, slip) = (&contacts.perpendicular[i].1, &contacts.slips[i]);
-            let friction = contacts.friction_of(i);
-            let phi = pair.load_coefficients(&contacts.block(i), anchor, slip, friction)
-                - pair.load_coefficients(&base_state, anchor, slip, friction);
+            let phi = contacts.load_coefficients(pair, i, &contacts.block(i))
+                - contacts.load_coefficients(pair, i, &base_state);
             let mut f = BlockVector::zeros();
             for (ga, pa) in pair.jump_basis().iter().zip(phi.iter()) {
                 f += ga * *pa;

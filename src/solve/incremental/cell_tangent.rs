@@ -32,7 +32,7 @@ impl RunState {
         let blocks: Vec<BlockCoefficients> = (0..setup.pairs.len())
             .map(|i| {
                 setup.pairs[i].block_coefficients(
-                    &self.contacts.block(i),
+                    &self.contacts.consistent_block(i),
                     self.tangent_friction(setup, i),
                     setup.stabilization,
                 )

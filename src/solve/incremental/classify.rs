@@ -8,7 +8,7 @@ use super::options::{
 };
 use super::return_mapping::{classify, gather, hold, unsettled_force, Trial};
 use super::StickSlip;
-use crate::contact::ContactState;
+use crate::contact::{ContactState, Friction};
 use rayon::prelude::*;
 
 /// The trials of every contact and the contacts they change.
@@ -115,7 +115,18 @@ impl StickSlip<'_, '_, '_> {
                     && sliding
                     && contacts.compressed[i] != (t.normal_force > 0.0));
             let lags = (!held
-                && unsettled_force(t, contacts.directions[i], contacts.perpendicular[i]))
+                && unsettled_force(
+                    t,
+                    contacts.directions[i],
+                    {
+                        let b = contacts.block(i);
+                        (b.direction, b.k_perp, contacts.perpendicular[i].1)
+                    },
+                    // The bound's slope is in the block of a Coulomb contact only.
+                    contacts.frozen[i]
+                        .filter(|_| matches!(contacts.friction_of(i), Friction::Coulomb { .. }))
+                        .map(|f| f.bound),
+                ))
                 // A sliding Coulomb contact's bound moved (the fixed point on the bounds, or a
                 // symmetric step of the consistent tangent).
                 || ((setup.bound_fixed_point || contacts.symmetric_step)

@@ -3,11 +3,15 @@
 //! point, and the switches that detect chatter.
 
 use super::bound_acceleration::BoundAcceleration;
-use super::options::{BOUND_RELAXATION_AFTER, CHATTER_SWITCHES, SETTLING_ITERATIONS};
+use super::factors::ReferenceBlock;
+use super::options::{
+    BOUND_RELAXATION_AFTER, CHATTER_SWITCHES, FROZEN_ITERATIONS, FROZEN_STIFFNESS_CHANGE,
+    FROZEN_TURN, SETTLING_ITERATIONS,
+};
 use super::return_mapping::Trial;
 use super::setup::Setup;
 use crate::contact::{BlockState, ContactPair, ContactState, Friction};
-use nalgebra::Vector2;
+use nalgebra::{Vector2, Vector6};
 
 /// Per contact, what the next system is assembled with and what the increment commits.
 #[derive(Clone)]
@@ -19,6 +23,9 @@ pub(super) struct ContactStates {
     pub slips: Vec<Vector2<f64>>,
     /// Consistent tangent across the slip direction: (k⊥, anchor) per contact.
     pub perpendicular: Vec<(f64, Vector2<f64>)>,
+    /// Sliding contacts whose block keeps the reference factorization's tangent (see
+    /// [`FrozenTangent`]); `None`: the consistent tangent at the last trial.
+    pub frozen: Vec<Option<FrozenTangent>>,
     /// Coulomb fixed point: each contact's bound c + μ max(N, 0) at the last classification,
     /// the load its sliding force is assembled with (empty without Coulomb friction).
     pub bounds: Vec<f64>,
@@ -59,6 +66,7 @@ impl ContactStates {
             directions: vec![Vector2::zeros(); n],
             slips: vec![Vector2::zeros(); n],
             perpendicular: vec![(0.0, Vector2::zeros()); n],
+            frozen: vec![None; n],
             bounds: match friction {
                 Friction::Coulomb { cohesion, .. } => vec![cohesion; n],
                 _ => Vec::new(),
@@ -118,12 +126,53 @@ impl ContactStates {
         }
     }
 
-    /// What contact i's block is assembled from.
+    /// What contact i's block is assembled from: the consistent tangent at its last trial,
+    /// or the reference's where it is frozen.
     pub fn block(&self, i: usize) -> BlockState {
+        match self.frozen[i] {
+            Some(f) => BlockState {
+                state: self.states[i],
+                direction: f.direction,
+                k_perp: f.k_perp,
+            },
+            None => self.consistent_block(i),
+        }
+    }
+
+    /// The load coefficients of contact i in block state `s` (see
+    /// [`ContactPair::load_coefficients`]), a frozen tangent's offset included when it slides.
+    pub fn load_coefficients(&self, pair: &ContactPair, i: usize, s: &BlockState) -> Vector6<f64> {
+        let mut phi = pair.load_coefficients(
+            s,
+            &self.perpendicular[i].1,
+            &self.slips[i],
+            self.friction_of(i),
+        );
+        if s.state == ContactState::Slip {
+            let offset = self.frozen_offset(i);
+            phi[1] -= offset[0];
+            phi[2] -= offset[1];
+        }
+        phi
+    }
+
+    /// Contact i's consistent tangent at its last trial (the cell tangent's block).
+    pub fn consistent_block(&self, i: usize) -> BlockState {
         BlockState {
             state: self.states[i],
             direction: self.directions[i],
             k_perp: self.perpendicular[i].0,
+        }
+    }
+
+    /// The tangential force f(q_k) − f̃(q_k) contact i's load lacks when its block is frozen
+    /// (see [`FrozenTangent`]): b (d − d_f), zero otherwise.
+    pub fn frozen_offset(&self, i: usize) -> Vector2<f64> {
+        match self.frozen[i] {
+            Some(f) if self.states[i] == ContactState::Slip => {
+                (self.directions[i] - f.direction) * f.bound
+            }
+            _ => Vector2::zeros(),
         }
     }
 
@@ -178,6 +227,7 @@ impl ContactStates {
         changed: &[usize],
         iteration: usize,
         direction_tol: f64,
+        reference: Option<&[ReferenceBlock]>,
     ) {
         for &i in changed {
             // A change of state always counts as a switch, and after SETTLING_ITERATIONS every
@@ -243,6 +293,36 @@ impl ContactStates {
                 (0.0, Vector2::zeros())
             };
         }
+        let reference = reference.filter(|_| iteration < FROZEN_ITERATIONS);
+        for i in 0..trials.len() {
+            self.frozen[i] = reference.and_then(|r| self.freeze(i, &trials[i], &r[i]));
+        }
+    }
+
+    /// The reference's tangent for contact i, sliding at trial `t`, when the reference `r` has
+    /// it sliding with the same friction law, a slip direction within [`FROZEN_TURN`] and a
+    /// k⊥ within [`FROZEN_STIFFNESS_CHANGE`] of the consistent one at `t`.
+    fn freeze(&self, i: usize, t: &Trial, r: &ReferenceBlock) -> Option<FrozenTangent> {
+        let friction = self.friction_of(i);
+        let (k, k_ref) = (self.perpendicular[i].0, r.state.k_perp);
+        let sliding = t.state == ContactState::Slip && self.states[i] == ContactState::Slip;
+        (sliding
+            && !self.held(i)
+            && r.state.state == ContactState::Slip
+            && std::mem::discriminant(&friction) == std::mem::discriminant(&r.friction)
+            && k > 0.0
+            && k_ref > 0.0
+            && (k / k_ref - 1.0).abs() <= FROZEN_STIFFNESS_CHANGE
+            && (self.directions[i] - r.state.direction).norm() <= FROZEN_TURN)
+            .then_some(FrozenTangent {
+                direction: r.state.direction,
+                k_perp: k_ref,
+                bound: match friction {
+                    Friction::Tresca { bound } => bound,
+                    Friction::Coulomb { .. } => t.bound,
+                    Friction::None => 0.0,
+                },
+            })
     }
 
     /// Whether trial `t` switches contact i: another state, or a slip direction that moved by
@@ -254,6 +334,22 @@ impl ContactStates {
                 && t.trial_norm / penalty_tangent * (t.direction - self.directions[i]).norm()
                     > direction_tol)
     }
+}
+
+/// A sliding contact linearized with the reference factorization's tangent instead of the
+/// consistent one at its trial (modified Newton): its block keeps the reference's slip
+/// direction d_f and k⊥, so it is no change of the correction's capacitance, while its load
+/// makes the linearized force exact at the iterate q_k: the block's form f̃ = b d_f + k⊥ p pᵀ
+/// (u_t − a) (Coulomb: the bound's slope μ p_N d_f nᵀ too) gives b d_f there, the law b d, and
+/// the load carries the difference b (d − d_f). The fixed point is the law's whatever the
+/// tangent; the tangent only sets how fast it is reached, hence the bounds on how far it may
+/// be from the consistent one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct FrozenTangent {
+    pub direction: Vector2<f64>,
+    pub k_perp: f64,
+    /// The friction bound b at q_k.
+    pub bound: f64,
 }
 
 /// The value at `alpha` of the line through (α₂, b₂) and (α₁, b₁), at least `floor`; b₁ when

@@ -11,13 +11,14 @@ use super::setup::Setup;
 use super::StickSlip;
 use crate::constraints::Discretization;
 use crate::contact::ContactPair;
-use crate::solve::low_rank::{Capacitance, LowRankCorrection, SparseColumn};
+use crate::solve::low_rank::{Capacitance, ContactChange, LowRankCorrection, SparseColumn};
 use crate::solve::static_solve::{backward_tolerance, check_backward_error};
 use crate::Error;
 use fibercell_solver::{
     backward_from_product, norm_inf, relative_from_product, CscRef, LinearSolver, SolveInfo,
     SolveReport, SolverError,
 };
+use nalgebra::Vector6;
 
 /// A low-rank solve that reached the check's `tolerance`: the solution, its backward error,
 /// its relative residual ‖b − Ax‖₂/‖b‖₂, the correction steps it took, and whether it stopped
@@ -155,6 +156,12 @@ impl StickSlip<'_, '_, '_> {
     /// comes with its capacitance while unchecked: not in the last iteration allowed, the
     /// residual check waits until the contact states are consistent with the solution (the
     /// states in between only steer the iteration; see [`StickSlip::confirm`]).
+    ///
+    /// The contacts whose load alone changed are columns of U while they fit in the bound on
+    /// the columns; past it, only the contacts whose block changed are, and the assembled load
+    /// is solved for instead (a forward half more per solve). Once the reference has sliding
+    /// contacts, their blocks mostly stay (see `contact_states::FrozenTangent`) while their
+    /// loads change in every iteration: as columns they would fill the bound at once.
     pub(super) fn solve_low_rank(
         &mut self,
         inc: &mut Increment,
@@ -168,7 +175,7 @@ impl StickSlip<'_, '_, '_> {
             ..
         } = self;
         let opts = &setup.opts;
-        let (Some(changes), Some(a0), true) = (
+        let (Some(all_changes), Some(a0), true) = (
             system.changes.as_deref(),
             factors.backends.reference.as_mut(),
             setup.n_free() > 0 && !factors.refresh_reference,
@@ -176,26 +183,51 @@ impl StickSlip<'_, '_, '_> {
             return Ok(None);
         };
         let low_rank = &mut factors.low_rank;
-        let (order, new) = low_rank.size_of(changes);
+        let fits = |changes: &[ContactChange]| {
+            let (order, new) = low_rank.size_of(changes);
+            (low_rank.len() + new <= opts.max_low_rank_columns).then_some(order)
+        };
+        let block_changes: Vec<ContactChange>;
+        let (changes, order, assembled_load) = match fits(all_changes) {
+            Some(order) => (all_changes, order, false),
+            None => {
+                block_changes = all_changes
+                    .iter()
+                    .filter(|c| c.changes_block())
+                    .map(|c| ContactChange {
+                        load: Vector6::zeros(),
+                        ..*c
+                    })
+                    .collect();
+                let Some(order) = fits(&block_changes) else {
+                    factors.refresh_reference = true;
+                    return Ok(None);
+                };
+                (&block_changes[..], order, true)
+            }
+        };
         let affordable = match opts.max_capacitance_order {
             Some(max) => order <= max,
             None => factors.cost.worth(order),
         };
-        if low_rank.len() + new > opts.max_low_rank_columns {
-            factors.refresh_reference = true;
-            return Ok(None);
-        }
         if !affordable {
             return Ok(None);
         }
         let locate = |e| setup.locate(e);
         let column = |c: usize, k: usize| low_rank_column(&setup.pairs[c], &setup.disc, k);
         let x0 = match factors.reference_solution.take() {
+            kept if assembled_load => {
+                factors.reference_solution = kept;
+                low_rank
+                    .extend(a0.as_mut(), changes, column)
+                    .map_err(locate)?;
+                None
+            }
             Some(x0) => {
                 low_rank
                     .extend(a0.as_mut(), changes, column)
                     .map_err(locate)?;
-                x0
+                Some(x0)
             }
             // b₀ = b − U Δχ, the load with every contact as in the reference: from the
             // references of two earlier increments when affine in α, else its forward half
@@ -225,7 +257,7 @@ impl StickSlip<'_, '_, '_> {
                 if let Some(b0) = solved_b0 {
                     affine.record(alpha, b0, &x0);
                 }
-                x0
+                Some(x0)
             }
         };
         inc.low_rank_order = inc.low_rank_order.max(order);
@@ -239,9 +271,15 @@ impl StickSlip<'_, '_, '_> {
         inc.low_rank_bytes = inc
             .low_rank_bytes
             .max(low_rank.memory_bytes() + cap.memory_bytes());
-        let load = low_rank.active_load(changes);
-        let first = low_rank.solve_from(a0.as_mut(), &cap, &x0, &load);
-        factors.reference_solution = Some(x0);
+        let first = match x0 {
+            Some(x0) => {
+                let load = low_rank.active_load(changes);
+                let first = low_rank.solve_from(a0.as_mut(), &cap, &x0, &load);
+                factors.reference_solution = Some(x0);
+                first
+            }
+            None => low_rank.solve(a0.as_mut(), &cap, &system.rhs),
+        };
         let solved = match first {
             Ok(x) if iteration < opts.max_state_iterations && x.iter().all(|v| v.is_finite()) => {
                 Some((

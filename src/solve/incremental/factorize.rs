@@ -104,12 +104,12 @@ impl StickSlip<'_, '_, '_> {
         let key = (
             nonsymmetric,
             contacts.states.clone(),
-            contacts.directions.clone(),
-            contacts
-                .perpendicular
-                .iter()
-                .map(|p| p.0)
-                .collect::<Vec<f64>>(),
+            (0..contacts.states.len())
+                .map(|i| contacts.block(i).direction)
+                .collect::<Vec<_>>(),
+            (0..contacts.states.len())
+                .map(|i| contacts.block(i).k_perp)
+                .collect::<Vec<_>>(),
         );
         inc.lap(|t| &mut t.factorize);
         let mut refactorized = false;
@@ -192,6 +192,7 @@ pub(super) fn reference_blocks(
                 friction: contacts.friction_of(i),
                 anchor: contacts.perpendicular[i].1,
                 slip: contacts.slips[i],
+                offset: contacts.frozen_offset(i),
             }
         })
         .collect()

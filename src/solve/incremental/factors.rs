@@ -1,11 +1,12 @@
 //! The factorizations of a stick/slip run: the backends, the reference factorization A₀ with
 //! the contact blocks it was built from, and the low-rank correction accumulated on it.
 
+use crate::contact::ContactPair;
 use crate::contact::{BlockCoefficients, BlockState, ContactState, Friction};
 use crate::solve::affine_reference::AffineReferences;
 use crate::solve::low_rank::{LowRankCorrection, Reference};
 use fibercell_solver::LinearSolver;
-use nalgebra::Vector2;
+use nalgebra::{Vector2, Vector6};
 
 /// What an assembled matrix was built from: symmetry, states, slip directions, k⊥ of each
 /// contact.
@@ -70,6 +71,20 @@ pub(super) struct ReferenceBlock {
     /// The slip its load was computed at: the reference load b₀ keeps it, so that b₀ changes
     /// with α only (see [`AffineReferences`]); a contact whose slip moved since is a change.
     pub slip: Vector2<f64>,
+    /// A frozen tangent's offset in its load (see `ContactStates::frozen_offset`).
+    pub offset: Vector2<f64>,
+}
+
+impl ReferenceBlock {
+    /// The load coefficients of the contact in the reference.
+    pub fn load(&self, pair: &ContactPair) -> Vector6<f64> {
+        let mut phi = pair.load_coefficients(&self.state, &self.anchor, &self.slip, self.friction);
+        if self.state.state == ContactState::Slip {
+            phi[1] -= self.offset[0];
+            phi[2] -= self.offset[1];
+        }
+        phi
+    }
 }
 
 /// The factorizations and what the low-rank solves keep on the reference.

@@ -286,6 +286,7 @@ impl<'s, 'a, 'h> StickSlip<'s, 'a, 'h> {
                 &changed,
                 iteration,
                 direction_tol,
+                self.factors.reference.as_deref(),
             );
             inc.lap(|t| &mut t.classify);
         }

@@ -58,9 +58,11 @@ pub struct IncrementalOptions {
     /// refactorized and becomes the new reference (default true). Needs a direct symmetric
     /// backend; Coulomb sliding (a nonsymmetric E) is solved on the symmetric factorization.
     pub reuse_factor: bool,
-    /// Columns of the low-rank correction kept on one reference factorization; one more
-    /// refactorizes the current matrix as the new reference. S takes 8 bytes × this squared
-    /// (default [`MAX_LOW_RANK_COLUMNS`], 512 MB).
+    /// Columns of the low-rank correction kept on one reference factorization. Past it, the
+    /// contacts whose load alone changed are left out of the correction (the assembled load is
+    /// solved for instead); when the changed blocks alone need more, the current matrix is
+    /// refactorized as the new reference. S takes 8 bytes × this squared (default
+    /// [`MAX_LOW_RANK_COLUMNS`], 128 MiB).
     pub max_low_rank_columns: usize,
     /// A state iteration whose capacitance matrix is larger than this factorizes its matrix
     /// directly instead, as the new reference; `None` (default): decided by the measured
@@ -227,6 +229,21 @@ pub(super) const CHATTER_SWITCHES: usize = 4;
 /// none, and the end resultant of the curve moved by less than 2e-10 of itself.
 pub(super) const SLIP_DIRECTION_TOLERANCE: f64 = 1e-10;
 
+/// The farthest a sliding contact's slip direction may have turned from the reference's,
+/// |d − d_f|, for its block to keep the reference's tangent (see
+/// `contact_states::FrozenTangent`).
+pub(super) const FROZEN_TURN: f64 = 0.01;
+
+/// The largest relative change of k⊥ from the reference's for a sliding contact's block to
+/// keep the reference's tangent.
+pub(super) const FROZEN_STIFFNESS_CHANGE: f64 = 0.1;
+
+/// State iterations of an increment whose solves may keep a reference's tangent: the
+/// modified Newton iteration converges linearly, and where it is slow (measured on the L
+/// non-woven: 50 iterations and every sliding contact held, where Newton takes 8) the
+/// consistent tangent takes over.
+pub(super) const FROZEN_ITERATIONS: usize = 6;
+
 /// The backward error a factor-reuse CG solve must reach, relative to the accepted one of a
 /// direct solve. The slip directions are read off the last digits of the tangential
 /// displacements, so a CG solve must be as accurate as a direct one: at 1e-3 the directions of
@@ -246,8 +263,9 @@ pub(super) const REUSE_ACCURACY: f64 = 1e-5;
 pub(super) const LOW_RANK_MATCH: f64 = 10.0;
 
 /// Columns of the low-rank correction kept on one factorization before refactorizing, by
-/// default: S, their dense products, then takes 8 bytes × this squared (512 MB).
-pub const MAX_LOW_RANK_COLUMNS: usize = 8192;
+/// default: S, their dense products, then takes 8 bytes × this squared (128 MiB), and the
+/// capacitance factorization as much again at most.
+pub const MAX_LOW_RANK_COLUMNS: usize = 4096;
 
 /// A direct symmetric factorization is kept beside the reference A₀ (whose low-rank columns
 /// later iterations with fewer changes reuse) only while a factor has at most this many bytes;

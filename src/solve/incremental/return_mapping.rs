@@ -147,25 +147,32 @@ pub(super) fn classify(
     t
 }
 
-/// Whether a sliding contact's force in the solved system, the bound along the direction it
-/// was assembled with (`direction`) plus the k⊥ spring stretched from its anchor
-/// (`perpendicular`), differs from the law's, the bound along the trial direction, by more
-/// than [`BOUND_TOLERANCE`] of the bound. The direction test of the state iteration measures
-/// the change in displacement, which misses this where p_T (and with it k⊥) is large: on the
-/// S cell a contact with k⊥ = 1.6·10⁷ N/m passed it with a spring force of 3.6·10⁻³ of its
-/// bound, the equilibrium residual of the increment 5.6·10⁻⁴.
+/// Whether a sliding contact's force in the solved system differs from the law's, the bound
+/// along the trial direction, by more than [`BOUND_TOLERANCE`] of the bound. The solved force
+/// is the bound along the direction it was assembled with (`direction`) plus the k⊥ spring of
+/// its block stretched from its anchor (`block`: the block's slip direction, k⊥ and anchor),
+/// and, for a block frozen at the linearization bound b_k (`frozen`, see
+/// `contact_states::FrozenTangent`), (b − b_k)(d_f − d) from the bound's slope along the
+/// block's direction d_f. The direction test of the state iteration measures the change in
+/// displacement, which misses this where p_T (and with it k⊥) is large: on the S cell a
+/// contact with k⊥ = 1.6·10⁷ N/m passed it with a spring force of 3.6·10⁻³ of its bound, the
+/// equilibrium residual of the increment 5.6·10⁻⁴.
 pub(super) fn unsettled_force(
     t: &Trial,
     direction: Vector2<f64>,
-    perpendicular: (f64, Vector2<f64>),
+    block: (Vector2<f64>, f64, Vector2<f64>),
+    frozen: Option<f64>,
 ) -> bool {
     if t.state != ContactState::Slip || !(t.bound > 0.0) {
         return false;
     }
-    let (k_perp, anchor) = perpendicular;
-    let across = Vector2::new(-direction[1], direction[0]);
+    let (block_direction, k_perp, anchor) = block;
+    let across = Vector2::new(-block_direction[1], block_direction[0]);
     let spring = k_perp * across.dot(&(t.relative - anchor));
-    let error = t.bound * (t.direction - direction).norm() + spring.abs();
+    let slope = frozen.map_or(0.0, |b| {
+        (t.bound - b) * (block_direction - direction).norm()
+    });
+    let error = t.bound * (t.direction - direction).norm() + slope.abs() + spring.abs();
     error > BOUND_TOLERANCE * t.bound
 }
 
