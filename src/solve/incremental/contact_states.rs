@@ -142,18 +142,13 @@ impl ContactStates {
     /// The load coefficients of contact i in block state `s` (see
     /// [`ContactPair::load_coefficients`]), a frozen tangent's offset included when it slides.
     pub fn load_coefficients(&self, pair: &ContactPair, i: usize, s: &BlockState) -> Vector6<f64> {
-        let mut phi = pair.load_coefficients(
+        let phi = pair.load_coefficients(
             s,
             &self.perpendicular[i].1,
             &self.slips[i],
             self.friction_of(i),
         );
-        if s.state == ContactState::Slip {
-            let offset = self.frozen_offset(i);
-            phi[1] -= offset[0];
-            phi[2] -= offset[1];
-        }
-        phi
+        with_frozen_offset(phi, s.state, self.frozen_offset(i))
     }
 
     /// Contact i's consistent tangent at its last trial (the cell tangent's block).
@@ -334,6 +329,20 @@ impl ContactStates {
                 && t.trial_norm / penalty_tangent * (t.direction - self.directions[i]).norm()
                     > direction_tol)
     }
+}
+
+/// Load coefficients `phi` of a contact in `state` with a frozen tangent's `offset` (see
+/// [`ContactStates::frozen_offset`]) taken off its tangential rows when it slides.
+pub(super) fn with_frozen_offset(
+    mut phi: Vector6<f64>,
+    state: ContactState,
+    offset: Vector2<f64>,
+) -> Vector6<f64> {
+    if state == ContactState::Slip {
+        phi[1] -= offset[0];
+        phi[2] -= offset[1];
+    }
+    phi
 }
 
 /// A sliding contact linearized with the reference factorization's tangent instead of the

@@ -101,16 +101,13 @@ impl StickSlip<'_, '_, '_> {
         let solver = slot
             .as_mut()
             .ok_or(Error::Solver(SolverError::OutOfOrder("solve", "analyze")))?;
-        let key = (
-            nonsymmetric,
-            contacts.states.clone(),
-            (0..contacts.states.len())
-                .map(|i| contacts.block(i).direction)
-                .collect::<Vec<_>>(),
-            (0..contacts.states.len())
-                .map(|i| contacts.block(i).k_perp)
-                .collect::<Vec<_>>(),
-        );
+        let (directions, k_perp) = (0..contacts.states.len())
+            .map(|i| {
+                let b = contacts.block(i);
+                (b.direction, b.k_perp)
+            })
+            .unzip();
+        let key = (nonsymmetric, contacts.states.clone(), directions, k_perp);
         inc.lap(|t| &mut t.factorize);
         let mut refactorized = false;
         if make_reference || factors.factorized.as_ref() != Some(&key) {

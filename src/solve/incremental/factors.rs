@@ -78,12 +78,8 @@ pub(super) struct ReferenceBlock {
 impl ReferenceBlock {
     /// The load coefficients of the contact in the reference.
     pub fn load(&self, pair: &ContactPair) -> Vector6<f64> {
-        let mut phi = pair.load_coefficients(&self.state, &self.anchor, &self.slip, self.friction);
-        if self.state.state == ContactState::Slip {
-            phi[1] -= self.offset[0];
-            phi[2] -= self.offset[1];
-        }
-        phi
+        let phi = pair.load_coefficients(&self.state, &self.anchor, &self.slip, self.friction);
+        super::contact_states::with_frozen_offset(phi, self.state.state, self.offset)
     }
 }
 
