@@ -125,36 +125,6 @@ impl LowerTriangle {
         self.scaled_in_order(a, |j| j, scale, values)
     }
 
-    /// The scale S = diag(A)^(-1/2) of a triangle made by [`LowerTriangle::permuted`] with the
-    /// inverse of `fwd`: written in A's order to `scale`, returned in this triangle's order
-    /// for [`LowerTriangle::scaled_column`]. A diagonal entry that is missing or not positive
-    /// is [`SolverError::NotPositiveDefinite`] at A's column.
-    pub fn permuted_scale(
-        &self,
-        a: CscRef<'_>,
-        fwd: &[usize],
-        scale: &mut [f64],
-    ) -> Result<Vec<f64>, SolverError> {
-        self.scale_in_order(a, |j| fwd[j], scale)
-    }
-
-    /// Column `j` of S A S as (row, value), with `scale` in this triangle's order (from
-    /// [`LowerTriangle::permuted_scale`]) and `a` the values of the matrix it was made from:
-    /// the scaled triangle read where it is needed, without a copy.
-    pub fn scaled_column<'s>(
-        &'s self,
-        a: &'s [f64],
-        scale: &'s [f64],
-        j: usize,
-    ) -> impl Iterator<Item = (usize, f64)> + 's {
-        let sj = scale[j];
-        let range = self.col_ptr[j]..self.col_ptr[j + 1];
-        self.row_idx[range.clone()]
-            .iter()
-            .zip(&self.src[range])
-            .map(move |(&i, &k)| (i, a[k] * scale[i] * sj))
-    }
-
     /// values = S A S for the columns `cols` (`values` holding exactly their entries), halved
     /// over the threads down to runs of 2¹⁶ entries.
     fn scale_columns(&self, cols: Range<usize>, scale: &[f64], a: &[f64], values: &mut [f64]) {
@@ -218,6 +188,31 @@ impl LowerTriangle {
     }
 }
 
+/// The scale S = diag(A)^(-1/2) of P A Pᵀ (`fwd[new] = old`), read from A's diagonal:
+/// written in A's order to `scale`, returned in the new order. A diagonal entry that is
+/// missing or not positive is [`SolverError::NotPositiveDefinite`] at A's column.
+pub fn permuted_diagonal_scale(
+    a: CscRef<'_>,
+    fwd: &[usize],
+    scale: &mut [f64],
+) -> Result<Vec<f64>, SolverError> {
+    let mut local = vec![0.0; fwd.len()];
+    for (new, &old) in fwd.iter().enumerate() {
+        let (rows, values) = a.col(old);
+        // Rows are strictly ascending (a checked pattern).
+        let ajj = rows.binary_search(&old).map_or(0.0, |k| values[k]);
+        if !(ajj > 0.0) {
+            return Err(SolverError::NotPositiveDefinite {
+                column: old,
+                pivot: ajj,
+            });
+        }
+        local[new] = 1.0 / ajj.sqrt();
+        scale[old] = local[new];
+    }
+    Ok(local)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -257,24 +252,24 @@ mod tests {
         assert_eq!(p.row_idx, vec![0, 2, 1, 2, 2]);
         // (new 0 = old 2): a22 = 1, a21 → (new 2, new 0); (new 1 = old 0): a00, a10 → (2, 1).
         assert_eq!(pv, vec![1.0, 3.0 / 12.0, 1.0, 2.0 / 6.0, 1.0]);
-        // Read a column at a time instead: the same values.
-        let local = p.permuted_scale(a.as_ref(), &fwd, &mut ps).unwrap();
-        assert_eq!(ps, s);
-        let columns: Vec<(usize, f64)> = (0..3)
-            .flat_map(|j| {
-                p.scaled_column(a.as_ref().values(), &local, j)
-                    .collect::<Vec<_>>()
-            })
-            .collect();
-        assert_eq!(
-            columns,
-            p.row_idx.iter().copied().zip(pv).collect::<Vec<_>>()
-        );
+        // The scale alone from A's diagonal, in both orders.
+        let mut by_old = vec![0.0; 3];
+        let local = permuted_diagonal_scale(a.as_ref(), &fwd, &mut by_old).unwrap();
+        assert_eq!(by_old, s);
+        assert_eq!(local, vec![0.25, 0.5, 1.0 / 3.0]);
         let bad = CscMatrix::from_triplets(2, 2, &[(0, 0, 1.0), (1, 0, 1.0), (0, 1, 1.0)]).unwrap();
         let l = LowerTriangle::of(bad.as_ref());
         let e = l
             .scaled_values(bad.as_ref(), &mut [0.0; 2], &mut [0.0; 2])
             .unwrap_err();
+        assert_eq!(
+            e,
+            SolverError::NotPositiveDefinite {
+                column: 1,
+                pivot: 0.0
+            }
+        );
+        let e = permuted_diagonal_scale(bad.as_ref(), &[1, 0], &mut [0.0; 2]).unwrap_err();
         assert_eq!(
             e,
             SolverError::NotPositiveDefinite {

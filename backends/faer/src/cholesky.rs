@@ -11,7 +11,7 @@ use crate::block_solve_many::{solve_many_in_place, FactorBlocks};
 use crate::block_tree::{BlockTree, FactorView};
 use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
-use crate::supernodal_llt::{self, ScaledLower, SupernodalPlan, TaskSizes};
+use crate::supernodal_llt::{self, ScaledMatrix, SupernodalPlan, TaskSizes};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
@@ -23,9 +23,9 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use fibercell_solver::{
-    compute_ordering, AnalyzeInfo, Capabilities, CscRef, FillEstimate, FillOrdering,
-    ForwardColumns, LinearSolver, LowerTriangle, NodeGraph, PatternFingerprint, Permutation,
-    SolveInfo, SolverError,
+    compute_ordering, permuted_diagonal_scale, AnalyzeInfo, Capabilities, CscRef, FillEstimate,
+    FillOrdering, ForwardColumns, LinearSolver, LowerTriangle, NodeGraph, PatternFingerprint,
+    Permutation, SolveInfo, SolverError,
 };
 use std::sync::Arc;
 
@@ -39,8 +39,9 @@ pub enum CholeskyVariant {
     Ldlt,
 }
 
-/// faer sparse Cholesky for symmetric positive definite matrices (both triangles stored; the
-/// lower one is read).
+/// faer sparse Cholesky for symmetric positive definite matrices (both triangles stored; each
+/// entry is read once, from the lower triangle of A in the factor's order for the task-parallel
+/// LLᵀ and of A itself for faer's kernels).
 pub struct FaerCholesky {
     variant: CholeskyVariant,
     ordering: FillOrdering,
@@ -60,9 +61,6 @@ pub struct FaerCholesky {
 struct Analysis {
     n: usize,
     fingerprint: PatternFingerprint,
-    /// A's lower triangle: in the factor's order for a supernodal factor (factorized as it
-    /// is), else in A's (faer permutes it).
-    lower: LowerTriangle,
     /// The permutation faer factorizes with (`fwd[new] = old`).
     perm: Permutation,
     symbolic: SymbolicCholesky<usize>,
@@ -74,8 +72,19 @@ struct Analysis {
     factor_fwd: Vec<usize>,
     /// Its inverse, `inv[old] = new`.
     factor_inv: Vec<usize>,
-    /// The task plan of a supernodal LLᵀ factor (None: faer's own kernel factorizes).
-    plan: Option<SupernodalPlan>,
+    /// Which numeric kernel factorizes, with what it reads.
+    kernel: Kernel,
+}
+
+/// The numeric kernel of an analysis.
+enum Kernel {
+    /// A supernodal LLᵀ: this crate's task-parallel kernel on its plan, gathering each
+    /// supernode's columns from A itself.
+    Tasks(SupernodalPlan),
+    /// faer's kernel (LDLᵀ, a simplicial factor, a tree the plan cannot take) on a scaled
+    /// copy of A's lower triangle of this pattern: in the factor's order for a supernodal
+    /// factor (factorized as it is), else in A's (faer permutes it).
+    Faer(LowerTriangle),
 }
 
 struct Factor {
@@ -243,6 +252,42 @@ impl FaerCholesky {
 /// 100 µs of work; waking another thread costs microseconds).
 const PARALLEL_SOLVE_VALUES: usize = 1 << 18;
 
+/// The task-parallel supernodal LLᵀ of S A S into `f`, A's columns gathered where each
+/// supernode reads them.
+fn factorize_with_tasks(
+    an: &Analysis,
+    plan: &SupernodalPlan,
+    a: CscRef<'_>,
+    mut f: Factor,
+    pivot_tolerance: f64,
+    par: Par,
+) -> Result<Factor, SolverError> {
+    let SymbolicCholeskyRaw::Supernodal(sn) = an.symbolic.raw() else {
+        return Err(SolverError::Backend {
+            backend: "faer-cholesky",
+            code: -3,
+            message: "a task plan without a supernodal factor (an internal error)".into(),
+        });
+    };
+    let scale = permuted_diagonal_scale(a, &an.factor_fwd, &mut f.scale)?;
+    let scaled = ScaledMatrix {
+        a,
+        fwd: &an.factor_fwd,
+        inv: &an.factor_inv,
+        scale: &scale,
+    };
+    supernodal_llt::factorize_llt(
+        &mut f.l_values,
+        scaled,
+        pivot_tolerance,
+        sn,
+        plan,
+        threads(par),
+    )
+    .map_err(|p| pivot_error(an.factor_fwd[p.index], p.value))?;
+    Ok(f)
+}
+
 /// Threads of `par`.
 fn threads(par: Par) -> usize {
     match par {
@@ -270,23 +315,11 @@ impl LinearSolver for FaerCholesky {
         self.analysis = None;
         self.workspace = None;
         let n = a.ncols();
-        // The lower triangle is extracted while the ordering runs (METIS is sequential).
-        let (lower_tri, ordered) = rayon::join(|| LowerTriangle::of(a), || self.permutation(a));
-        let (perm, name, fill) = ordered?;
-        let lower = SymbolicSparseColMatRef::new_checked(
-            n,
-            n,
-            &lower_tri.col_ptr,
-            None,
-            &lower_tri.row_idx,
-        );
-        // faer keeps a custom ordering as it is, so the triangle in the factor's order is
-        // built while faer's symbolic factorization runs (sequential).
-        let (symbolic, permuted) = rayon::join(
-            || self.symbolic_for(lower, &perm),
-            || lower_tri.permuted(&perm.inv),
-        );
-        let symbolic = symbolic?;
+        let (perm, name, fill) = self.permutation(a)?;
+        // faer reads the lower triangle of the pattern it is given (its entries with row ≥
+        // column), so A's own pattern serves.
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
+        let symbolic = self.symbolic_for(pattern, &perm)?;
         // faer's supernodes store explicit zeros where they were relaxed; nnz(L) and the
         // flops are the structure's (from the node graph, else faer's column counts).
         let (nnz_l, flops) = fill.map_or_else(|| fill_and_flops(&symbolic), |f| (f.nnz_l, f.flops));
@@ -310,22 +343,21 @@ impl LinearSolver for FaerCholesky {
             _ => None,
         };
         debug_assert_eq!(factor_inv, perm.inv);
-        let lower_tri = if is_simplicial(&symbolic) {
-            lower_tri
-        } else {
-            permuted
+        let kernel = match plan {
+            Some(plan) => Kernel::Tasks(plan),
+            None if is_simplicial(&symbolic) => Kernel::Faer(LowerTriangle::of(a)),
+            None => Kernel::Faer(LowerTriangle::of(a).permuted(&perm.inv)),
         };
         self.analysis = Some(Arc::new(Analysis {
             n,
             fingerprint: a.fingerprint(),
-            lower: lower_tri,
             perm,
             schedule: SolveSchedule::new(&tree, threads(self.par)),
             tree,
             factor_fwd,
             factor_inv,
             symbolic,
-            plan,
+            kernel,
         }));
         Ok(info)
     }
@@ -348,28 +380,14 @@ impl LinearSolver for FaerCholesky {
                 scale: vec![0.0; n],
             },
         };
-        // A plan exists for supernodal LLᵀ analyses only.
-        if let (SymbolicCholeskyRaw::Supernodal(sn), Some(plan)) = (an.symbolic.raw(), &an.plan) {
-            // The scaled triangle is read where each supernode gathers it: no copy.
-            let scale = an.lower.permuted_scale(a, &an.factor_fwd, &mut f.scale)?;
-            let scaled = ScaledLower {
-                lower: &an.lower,
-                values: a.values(),
-                scale: &scale,
-            };
-            let threads = threads(self.par);
-            supernodal_llt::factorize_llt(
-                &mut f.l_values,
-                scaled,
-                self.pivot_tolerance,
-                sn,
-                plan,
-                threads,
-            )
-            .map_err(|p| pivot_error(an.factor_fwd[p.index], p.value))?;
-            self.factor = Some(Arc::new(f));
-            return Ok(());
-        }
+        let lower = match &an.kernel {
+            Kernel::Faer(lower) => lower,
+            Kernel::Tasks(plan) => {
+                let f = factorize_with_tasks(an, plan, a, f, self.pivot_tolerance, self.par)?;
+                self.factor = Some(Arc::new(f));
+                return Ok(());
+            }
+        };
         let mut ws = match self.workspace.take() {
             Some(ws) => ws,
             None => {
@@ -397,7 +415,7 @@ impl LinearSolver for FaerCholesky {
                 };
                 Workspace {
                     scratch: MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?,
-                    lower_values: vec![0.0; an.lower.nnz()],
+                    lower_values: vec![0.0; lower.nnz()],
                 }
             }
         };
@@ -406,18 +424,12 @@ impl LinearSolver for FaerCholesky {
             SymbolicCholeskyRaw::Simplicial(_) => None,
         };
         if supernodal.is_some() {
-            an.lower.scaled_permuted_values(
-                a,
-                &an.factor_fwd,
-                &mut f.scale,
-                &mut ws.lower_values,
-            )?;
+            lower.scaled_permuted_values(a, &an.factor_fwd, &mut f.scale, &mut ws.lower_values)?;
         } else {
-            an.lower
-                .scaled_values(a, &mut f.scale, &mut ws.lower_values)?;
+            lower.scaled_values(a, &mut f.scale, &mut ws.lower_values)?;
         }
         let lower = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &an.lower.col_ptr, None, &an.lower.row_idx),
+            SymbolicSparseColMatRef::new_checked(n, n, &lower.col_ptr, None, &lower.row_idx),
             &ws.lower_values,
         );
         let sym = &an.symbolic;

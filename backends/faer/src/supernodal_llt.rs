@@ -19,7 +19,7 @@ use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::{Accum, MatMut, MatRef, Par, Spec};
-use fibercell_solver::LowerTriangle;
+use fibercell_solver::CscRef;
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -282,15 +282,32 @@ struct UpdateBuffers {
     update: Vec<f64>,
 }
 
-/// A's lower triangle in the factor's order, read scaled (S A S) where a supernode gathers it.
+/// A read in the factor's order and scaled (S A S) where a supernode gathers it: column j of
+/// the permuted lower triangle is A's column `fwd[j]`, its rows renumbered by `inv` and
+/// those above j dropped (A stores both triangles), so no permuted copy of A exists.
 #[derive(Clone, Copy)]
-pub(crate) struct ScaledLower<'a> {
-    /// The triangle (made by `LowerTriangle::permuted`).
-    pub(crate) lower: &'a LowerTriangle,
-    /// A's values.
-    pub(crate) values: &'a [f64],
+pub(crate) struct ScaledMatrix<'a> {
+    /// A, with both triangles.
+    pub(crate) a: CscRef<'a>,
+    /// The factor's permutation, `fwd[new] = old` and `inv[old] = new`.
+    pub(crate) fwd: &'a [usize],
+    pub(crate) inv: &'a [usize],
     /// S in the factor's order.
     pub(crate) scale: &'a [f64],
+}
+
+impl<'a> ScaledMatrix<'a> {
+    /// Column `j` (factor's order) of the lower triangle of P S A S Pᵀ as (row, value), rows
+    /// in A's order of storage.
+    fn column(&self, j: usize) -> impl Iterator<Item = (usize, f64)> + 'a {
+        let (inv, scale) = (self.inv, self.scale);
+        let sj = scale[j];
+        let (rows, values) = self.a.col(self.fwd[j]);
+        rows.iter().zip(values).filter_map(move |(&r, &x)| {
+            let i = inv[r];
+            (i >= j).then(|| (i, x * scale[i] * sj))
+        })
+    }
 }
 
 /// A pivot of the scaled matrix at or below the tolerance: its column in the factor's order
@@ -321,7 +338,7 @@ impl Failure {
 /// plan, the factor being written and the failure flag.
 struct Context<'a> {
     sym: &'a Symbolic,
-    a: ScaledLower<'a>,
+    a: ScaledMatrix<'a>,
     pivot_tolerance: f64,
     plan: &'a SupernodalPlan,
     values: SharedFactor<'a>,
@@ -337,7 +354,7 @@ struct Context<'a> {
 /// error, the lowest such column found.
 pub(crate) fn factorize_llt(
     values: &mut [f64],
-    a: ScaledLower<'_>,
+    a: ScaledMatrix<'_>,
     pivot_tolerance: f64,
     sym: &Symbolic,
     plan: &SupernodalPlan,
@@ -482,8 +499,7 @@ impl<'a> Context<'a> {
         }
         for j in 0..width {
             let col = begin + j;
-            let a = self.a;
-            for (i, x) in a.lower.scaled_column(a.values, a.scale, col) {
+            for (i, x) in self.a.column(col) {
                 // A's entries lie in the factor's pattern.
                 let local = scratch.position[i] as usize;
                 ls[local + j * rows] += x;
@@ -651,13 +667,15 @@ mod tests {
     };
     use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
     use faer::Side;
-    use fibercell_solver::CscMatrix;
+    use fibercell_solver::{permuted_diagonal_scale, CscMatrix, LowerTriangle};
 
     /// A matrix with its lower triangle in the factor's order (AMD, supernodal), the scale in
     /// that order and the scaled values as a copy for faer's kernel.
     struct Case {
         a: CscMatrix,
         lower: LowerTriangle,
+        fwd: Vec<usize>,
+        inv: Vec<usize>,
         scale: Vec<f64>,
         scaled: Vec<f64>,
         sym: SymbolicCholesky<usize>,
@@ -684,10 +702,13 @@ mod tests {
             lower
                 .scaled_permuted_values(a.as_ref(), fwd, &mut by_old, &mut scaled)
                 .unwrap();
-            let scale = lower.permuted_scale(a.as_ref(), fwd, &mut by_old).unwrap();
+            let scale = permuted_diagonal_scale(a.as_ref(), fwd, &mut by_old).unwrap();
+            let (fwd, inv) = (fwd.to_vec(), inv.to_vec());
             Case {
                 a,
                 lower,
+                fwd,
+                inv,
                 scale,
                 scaled,
                 sym,
@@ -734,9 +755,10 @@ mod tests {
             let sn = self.supernodal();
             let plan =
                 SupernodalPlan::new(sn, threads, sizes).expect("an elimination tree's numbering");
-            let a = ScaledLower {
-                lower: &self.lower,
-                values: self.a.as_ref().values(),
+            let a = ScaledMatrix {
+                a: self.a.as_ref(),
+                fwd: &self.fwd,
+                inv: &self.inv,
                 scale: &self.scale,
             };
             let mut l = vec![0.0; sn.len_val()];
