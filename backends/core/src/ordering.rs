@@ -15,7 +15,7 @@ pub enum FillOrdering {
     /// Approximate minimum degree (faer's) on the [`NodeGraph`].
     Amd,
     /// Nested dissection through METIS `METIS_NodeND` (the better of two separators at each
-    /// level) on the [`NodeGraph`].
+    /// level) on the [`NodeGraph`], its nodes of degree ≤ 2 eliminated first.
     NestedDissection,
     /// A caller's permutation: `perm[new] = old`.
     Given(Vec<usize>),
