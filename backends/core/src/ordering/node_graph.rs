@@ -129,8 +129,9 @@ impl NodeGraph {
                 )))
             }
         };
-        let nodes = self.postordered(&nodes);
-        let fill = self.fill(&nodes);
+        let tree = self.tree_and_counts(&nodes);
+        let fill = self.fill_of(&nodes, &tree.1);
+        let nodes = self.postordered_of(&nodes, &tree);
         Ok((self.expand(&nodes)?, fill, ordering.clone()))
     }
 
@@ -139,22 +140,30 @@ impl NodeGraph {
     fn better_of_amd_and_nested_dissection(
         &self,
     ) -> Result<(Permutation, FillEstimate, FillOrdering), SolverError> {
-        let (amd, nd) = rayon::join(|| self.amd(), || self.nested_dissection());
+        // AMD is the faster: its tree and fill are made on its thread while METIS runs.
+        let with_tree = |nodes: Vec<usize>| {
+            let tree = self.tree_and_counts(&nodes);
+            let fill = self.fill_of(&nodes, &tree.1);
+            (nodes, tree, fill)
+        };
+        let (amd, nd) = rayon::join(|| self.amd().map(with_tree), || self.nested_dissection());
         let amd = amd?;
-        let amd_fill = self.fill(&amd);
-        let (nodes, fill, chosen) = match nd {
-            Err(SolverError::Unavailable { .. }) => (amd, amd_fill, FillOrdering::Amd),
+        let (nodes, tree, fill, chosen) = match nd {
+            Err(SolverError::Unavailable { .. }) => (amd.0, amd.1, amd.2, FillOrdering::Amd),
             nd => {
-                let nd = nd?;
-                let nd_fill = self.fill(&nd);
-                if nd_fill.flops < amd_fill.flops {
-                    (nd, nd_fill, FillOrdering::NestedDissection)
+                let nd = with_tree(nd?);
+                if nd.2.flops < amd.2.flops {
+                    (nd.0, nd.1, nd.2, FillOrdering::NestedDissection)
                 } else {
-                    (amd, amd_fill, FillOrdering::Amd)
+                    (amd.0, amd.1, amd.2, FillOrdering::Amd)
                 }
             }
         };
-        Ok((self.expand(&self.postordered(&nodes))?, fill, chosen))
+        Ok((
+            self.expand(&self.postordered_of(&nodes, &tree))?,
+            fill,
+            chosen,
+        ))
     }
 
     /// The scalar permutation of a node order (`nodes[new] = old node`): each node's columns
@@ -290,7 +299,11 @@ impl NodeGraph {
     /// j. Node j of width w with b unknowns below its block then has scalar column counts
     /// w + b, w − 1 + b, …, 1 + b. O(nnz of the node factor).
     pub fn fill(&self, nodes: &[usize]) -> FillEstimate {
-        let (_, below) = self.tree_and_counts(nodes);
+        self.fill_of(nodes, &self.tree_and_counts(nodes).1)
+    }
+
+    /// [`NodeGraph::fill`] from the order's unknowns below each node's block.
+    fn fill_of(&self, nodes: &[usize], below: &[usize]) -> FillEstimate {
         let mut fill = FillEstimate {
             nnz_l: 0,
             flops: 0.0,
@@ -341,8 +354,16 @@ impl NodeGraph {
     /// only the supernode numbered right before it, so this is the order in which relaxed
     /// amalgamation merges the most.
     pub fn postordered(&self, nodes: &[usize]) -> Vec<usize> {
+        self.postordered_of(nodes, &self.tree_and_counts(nodes))
+    }
+
+    /// [`NodeGraph::postordered`] from the order's tree and counts.
+    fn postordered_of(
+        &self,
+        nodes: &[usize],
+        (parent, below): &(Vec<usize>, Vec<usize>),
+    ) -> Vec<usize> {
         let m = nodes.len();
-        let (parent, below) = self.tree_and_counts(nodes);
         let count = |j: usize| below[j] + self.weight(nodes[j]);
         // Children lists, each by ascending count (a stable sort of the positions by count,
         // then pushed onto the lists in reverse so each list is read in ascending order).
