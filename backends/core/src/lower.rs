@@ -154,37 +154,10 @@ impl LowerTriangle {
         scale: &mut [f64],
         values: &mut [f64],
     ) -> Result<(), SolverError> {
-        let local = self.scale_in_order(a, old, scale)?;
+        let n = self.col_ptr.len() - 1;
+        let local = diagonal_scale(a, n, old, scale)?;
         self.scale_columns(0..local.len(), &local, a.values(), values);
         Ok(())
-    }
-
-    /// `scale[old(j)] = 1/√a_jj`, and the same in this triangle's order (returned).
-    fn scale_in_order(
-        &self,
-        a: CscRef<'_>,
-        old: impl Fn(usize) -> usize,
-        scale: &mut [f64],
-    ) -> Result<Vec<f64>, SolverError> {
-        let n = self.col_ptr.len() - 1;
-        let mut local = vec![0.0; n];
-        for j in 0..n {
-            let first = self.col_ptr[j];
-            let ajj = if first < self.col_ptr[j + 1] && self.row_idx[first] == j {
-                a.values()[self.src[first]]
-            } else {
-                0.0
-            };
-            if !(ajj > 0.0) {
-                return Err(SolverError::NotPositiveDefinite {
-                    column: old(j),
-                    pivot: ajj,
-                });
-            }
-            local[j] = 1.0 / ajj.sqrt();
-            scale[old(j)] = local[j];
-        }
-        Ok(local)
     }
 }
 
@@ -196,19 +169,28 @@ pub fn permuted_diagonal_scale(
     fwd: &[usize],
     scale: &mut [f64],
 ) -> Result<Vec<f64>, SolverError> {
-    let mut local = vec![0.0; fwd.len()];
-    for (new, &old) in fwd.iter().enumerate() {
-        let (rows, values) = a.col(old);
+    diagonal_scale(a, fwd.len(), |j| fwd[j], scale)
+}
+
+/// `scale[old(j)] = 1/√a_jj` for j < n, A's entry at (old(j), old(j)), and the same in the
+/// order of j (returned).
+fn diagonal_scale(
+    a: CscRef<'_>,
+    n: usize,
+    old: impl Fn(usize) -> usize,
+    scale: &mut [f64],
+) -> Result<Vec<f64>, SolverError> {
+    let mut local = vec![0.0; n];
+    for (j, l) in local.iter_mut().enumerate() {
+        let column = old(j);
+        let (rows, values) = a.col(column);
         // Rows are strictly ascending (a checked pattern).
-        let ajj = rows.binary_search(&old).map_or(0.0, |k| values[k]);
+        let ajj = rows.binary_search(&column).map_or(0.0, |k| values[k]);
         if !(ajj > 0.0) {
-            return Err(SolverError::NotPositiveDefinite {
-                column: old,
-                pivot: ajj,
-            });
+            return Err(SolverError::NotPositiveDefinite { column, pivot: ajj });
         }
-        local[new] = 1.0 / ajj.sqrt();
-        scale[old] = local[new];
+        *l = 1.0 / ajj.sqrt();
+        scale[column] = *l;
     }
     Ok(local)
 }

@@ -36,6 +36,14 @@ struct ChainReduction {
     graph: NodeGraph,
 }
 
+/// A node order (`nodes[new] = old node`), its elimination tree and unknowns below each node's
+/// block ([`NodeGraph::tree_and_counts`]), and its fill.
+struct Candidate {
+    nodes: Vec<usize>,
+    tree: (Vec<usize>, Vec<usize>),
+    fill: FillEstimate,
+}
+
 /// The fill a node ordering predicts for the scalar matrix's Cholesky factor (exact for the
 /// pattern; faer's relaxed supernodes may store a few explicit zeros more).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -129,10 +137,12 @@ impl NodeGraph {
                 )))
             }
         };
-        let tree = self.tree_and_counts(&nodes);
-        let fill = self.fill_of(&nodes, &tree.1);
-        let nodes = self.postordered_of(&nodes, &tree);
-        Ok((self.expand(&nodes)?, fill, ordering.clone()))
+        let c = self.candidate(nodes);
+        Ok((
+            self.expand(&self.postordered_of(&c.nodes, &c.tree))?,
+            c.fill,
+            ordering.clone(),
+        ))
     }
 
     /// Both candidates side by side (METIS and AMD are sequential); without METIS (the
@@ -141,29 +151,24 @@ impl NodeGraph {
         &self,
     ) -> Result<(Permutation, FillEstimate, FillOrdering), SolverError> {
         // AMD is the faster: its tree and fill are made on its thread while METIS runs.
-        let with_tree = |nodes: Vec<usize>| {
-            let tree = self.tree_and_counts(&nodes);
-            let fill = self.fill_of(&nodes, &tree.1);
-            (nodes, tree, fill)
-        };
-        let (amd, nd) = rayon::join(|| self.amd().map(with_tree), || self.nested_dissection());
+        let (amd, nd) = rayon::join(
+            || self.amd().map(|o| self.candidate(o)),
+            || self.nested_dissection(),
+        );
         let amd = amd?;
-        let (nodes, tree, fill, chosen) = match nd {
-            Err(SolverError::Unavailable { .. }) => (amd.0, amd.1, amd.2, FillOrdering::Amd),
+        let (best, chosen) = match nd {
+            Err(SolverError::Unavailable { .. }) => (amd, FillOrdering::Amd),
             nd => {
-                let nd = with_tree(nd?);
-                if nd.2.flops < amd.2.flops {
-                    (nd.0, nd.1, nd.2, FillOrdering::NestedDissection)
+                let nd = self.candidate(nd?);
+                if nd.fill.flops < amd.fill.flops {
+                    (nd, FillOrdering::NestedDissection)
                 } else {
-                    (amd.0, amd.1, amd.2, FillOrdering::Amd)
+                    (amd, FillOrdering::Amd)
                 }
             }
         };
-        Ok((
-            self.expand(&self.postordered_of(&nodes, &tree))?,
-            fill,
-            chosen,
-        ))
+        let nodes = self.postordered_of(&best.nodes, &best.tree);
+        Ok((self.expand(&nodes)?, best.fill, chosen))
     }
 
     /// The scalar permutation of a node order (`nodes[new] = old node`): each node's columns
@@ -215,9 +220,9 @@ impl NodeGraph {
     /// and its nodes between two contacts, then what they leave of degree ≤ 2), and the graph
     /// of the others with the edges those eliminations add (the neighbours of a node of degree
     /// 2 become adjacent). Eliminating such a node costs its column and adds at most that edge,
-    /// so ordering them first loses nothing a separator could gain: on the L non-woven 48,261
-    /// of 155,781 nodes go, METIS orders the rest in 25 % less time, and the factor is as
-    /// small (nnz(L) 7.88·10⁷ against 7.89·10⁷, flops 5.44 against 5.53·10¹⁰).
+    /// so ordering them first costs little a separator could gain: on the L non-woven 48,261
+    /// of 155,781 nodes go, METIS orders the rest in 25 % less time, and the factor grows by
+    /// 0.16 % (nnz(L) 7.851·10⁷ against 7.839·10⁷, flops 5.37 against 5.28·10¹⁰).
     #[cfg_attr(not(feature = "metis"), allow(dead_code))]
     fn without_chains(&self) -> ChainReduction {
         let m = self.nodes();
@@ -290,6 +295,13 @@ impl NodeGraph {
             backend: "metis",
             reason: "fibercell-solver was built without its `metis` feature".into(),
         })
+    }
+
+    /// A node order with its elimination tree and fill.
+    fn candidate(&self, nodes: Vec<usize>) -> Candidate {
+        let tree = self.tree_and_counts(&nodes);
+        let fill = self.fill_of(&nodes, &tree.1);
+        Candidate { nodes, tree, fill }
     }
 
     /// The scalar factor's fill under a node order (`nodes[new] = old node`), from the node
