@@ -199,11 +199,25 @@ impl<'a> CscRef<'a> {
     /// The fingerprint of the pattern.
     pub fn fingerprint(&self) -> PatternFingerprint {
         // FNV-1a over the indices in chunks of a fixed size on all threads, then over the
-        // chunks' hashes in order: the same value on any number of threads.
+        // chunks' hashes in order: the same value on any number of threads. Within a chunk
+        // four interleaved streams (index k to stream k mod 4), so that the multiplications
+        // do not wait on one another: 17 → 6.6 ms on L's pattern (2.7·10⁷ indices), called
+        // by every factorization.
         const CHUNK: usize = 1 << 16;
         const BASIS: u64 = 0xcbf2_9ce4_8422_2325;
         let fnv = |h: u64, x: u64| (h ^ x).wrapping_mul(0x0100_0000_01b3);
-        let chunk_hash = |c: &[usize]| c.iter().fold(BASIS, |h, &x| fnv(h, x as u64));
+        let chunk_hash = |c: &[usize]| {
+            let mut lanes = [BASIS, BASIS ^ 1, BASIS ^ 2, BASIS ^ 3];
+            let quads = c.chunks_exact(4);
+            let rest = quads.remainder();
+            for q in quads {
+                for (h, &x) in lanes.iter_mut().zip(q) {
+                    *h = fnv(*h, x as u64);
+                }
+            }
+            let h = rest.iter().fold(lanes[0], |h, &x| fnv(h, x as u64));
+            lanes[1..].iter().fold(h, |h, &x| fnv(h, x))
+        };
         let chunks: Vec<u64> = self
             .col_ptr
             .par_chunks(CHUNK)
@@ -536,6 +550,46 @@ mod tests {
         v[190_000] = f64::INFINITY;
         v[3] = 2.0;
         assert_eq!(diagonal(v).as_ref().first_non_finite(), Some(131_000));
+    }
+
+    /// The fingerprint tells apart patterns of one order and entry count — one column's
+    /// off-diagonal row moved, or two neighbouring columns' (in different streams) — and is
+    /// the same on one thread and on several (200,001 pointers and 400,000 rows: 10 chunks).
+    #[test]
+    fn the_fingerprint_sees_moved_entries_and_not_the_threads() {
+        let n = 200_000;
+        // Two entries per column: the diagonal and row (j + shift) mod n.
+        let pattern = |shift: &dyn Fn(usize) -> usize| {
+            let rows: Vec<usize> = (0..n)
+                .flat_map(|j| {
+                    let (a, b) = (j, (j + shift(j)) % n);
+                    [a.min(b), a.max(b)]
+                })
+                .collect();
+            CscMatrix::new(
+                n,
+                n,
+                (0..=n).map(|j| 2 * j).collect(),
+                rows,
+                vec![1.0; 2 * n],
+            )
+            .unwrap()
+        };
+        let base = pattern(&|_| 1);
+        let moved = pattern(&|j| if j == 150_001 { 2 } else { 1 });
+        let swapped = pattern(&|j| match j {
+            7 => 2,
+            8 => 1_000,
+            _ => 1,
+        });
+        let f = base.as_ref().fingerprint();
+        assert_ne!(f, moved.as_ref().fingerprint());
+        assert_ne!(f, swapped.as_ref().fingerprint());
+        let one_thread = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        assert_eq!(one_thread.install(|| base.as_ref().fingerprint()), f);
     }
 
     /// `structural_asymmetry` names the first entry in column order whose mirror is missing,
