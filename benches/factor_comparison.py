@@ -25,6 +25,7 @@ also given as a fraction of that DGEMM rate.
 
 import argparse
 import ctypes
+import importlib.metadata
 import json
 import os
 import platform
@@ -166,6 +167,33 @@ def blas_of(binary):
         return []
 
 
+def cpu_model():
+    """The CPU's model name, family and model (MKL's code paths differ between Intel and AMD)."""
+    fields = {}
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                fields.setdefault(key.strip(), value.strip())
+    except OSError:
+        pass
+    if "model name" not in fields:
+        return platform.processor() or platform.machine()
+    return f"{fields['model name']} (family {fields.get('cpu family')}, model {fields.get('model')})"
+
+
+def package_version(name):
+    try:
+        return importlib.metadata.version(name)
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
+def git_commit():
+    out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True)
+    return out.stdout.strip() or None
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--presets", default="M,L")
@@ -176,10 +204,13 @@ def main():
     args = parser.parse_args()
 
     machine = {
-        "cpu": platform.processor() or platform.machine(),
+        "cpu": cpu_model(),
         "threads": os.cpu_count(),
         "dgemm_gflops_two_threads": dgemm_gflops(),
         "cholmod_blas": blas_of(args.fibercell),
+        "mkl": package_version("mkl"),
+        "pypardiso": package_version("pypardiso"),
+        "fibercell_commit": git_commit(),
     }
     print(f"DGEMM (NumPy OpenBLAS, 2 threads): {machine['dgemm_gflops_two_threads']:.1f} GFLOP/s; "
           f"CHOLMOD's BLAS: {machine['cholmod_blas']}", flush=True)
