@@ -16,9 +16,6 @@ use crate::model::Model;
 use nalgebra::{SMatrix, Vector3};
 use rayon::prelude::*;
 
-/// A consistent load on an element image: ((element, period shift), 12-vector).
-type ImageLoad = ((usize, [i32; 2]), SMatrix<f64, 12, 1>);
-
 /// At most this many pixels (the pixel grows beyond it).
 const MAX_PIXELS: usize = 4_000_000;
 
@@ -95,20 +92,26 @@ pub fn pressure_load(model: &Model, g: &CellGeometry, p: f64, pixel: f64) -> Pre
         }
     }
     // Rasterize band by band (in parallel): per pixel the highest fiber surface over its centre,
-    // ties to the first image in (element, shift) order; then the pixel's force on that image.
+    // ties to the first image in (element, shift) order; each image sums the Lagrange weights
+    // of its pixels' centerline parameters.
     const BAND: usize = 128;
     let pixel_force = p * hx * hy;
-    let bands: Vec<(usize, Vec<ImageLoad>)> = (0..ny.div_ceil(BAND))
+    let bands: Vec<Vec<(u32, u32, Weights)>> = (0..ny.div_ceil(BAND))
         .into_par_iter()
         .map(|band| {
             let v0 = band * BAND;
             let v1 = (v0 + BAND).min(ny);
             let mut top = vec![f64::NEG_INFINITY; (v1 - v0) * nx];
             let mut hit: Vec<(u32, f64)> = vec![(u32::MAX, 0.0); (v1 - v0) * nx];
+            // The images reaching into this band, in (element, shift) order; `hit` holds
+            // positions in this list.
+            let mut present: Vec<u32> = Vec::new();
             for (k, &(e, s, r0, r1)) in images.iter().enumerate() {
                 if r1 < v0 || r0 >= v1 {
                     continue;
                 }
+                let local = present.len() as u32;
+                present.push(k as u32);
                 let [a, b] = ends(e, s);
                 let r = radius(e);
                 let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
@@ -135,77 +138,128 @@ pub fn pressure_load(model: &Model, g: &CellGeometry, p: f64, pixel: f64) -> Pre
                         let idx = (v - v0) * nx + u;
                         if z > top[idx] {
                             top[idx] = z;
-                            hit[idx] = (k as u32, t);
+                            hit[idx] = (local, t);
                         }
                     }
                 }
             }
-            let mut count = 0;
-            let mut loads: Vec<ImageLoad> = Vec::new();
-            for &(k, t) in &hit {
-                if k == u32::MAX {
+            let mut sums: Vec<(u32, Weights)> = vec![(0, [0.0; 4]); present.len()];
+            for &(local, t) in &hit {
+                if local == u32::MAX {
                     continue;
                 }
-                count += 1;
-                let (e, s, ..) = images[k as usize];
-                let f = interpolation(e, t).transpose() * Vector3::new(0.0, 0.0, -pixel_force);
-                loads.push(((e, s), f));
-            }
-            loads.sort_by_key(|&(key, _)| key);
-            let mut merged: Vec<ImageLoad> = Vec::new();
-            for (key, f) in loads {
-                match merged.last_mut() {
-                    Some(last) if last.0 == key => last.1 += f,
-                    _ => merged.push((key, f)),
+                let (count, w) = &mut sums[local as usize];
+                *count += 1;
+                for (wj, lj) in w.iter_mut().zip(lagrange(t)) {
+                    *wj += lj;
                 }
             }
-            (count, merged)
+            present
+                .into_iter()
+                .zip(sums)
+                .filter(|(_, (count, _))| *count > 0)
+                .map(|(k, (count, w))| (k, count, w))
+                .collect()
         })
         .collect();
-    let hits: usize = bands.iter().map(|b| b.0).sum();
+    let mut weights: Vec<Weights> = vec![[0.0; 4]; images.len()];
+    let mut loaded = vec![false; images.len()];
+    let mut hits = 0usize;
+    for (k, count, w) in bands.into_iter().flatten() {
+        hits += count as usize;
+        loaded[k as usize] = true;
+        for (a, b) in weights[k as usize].iter_mut().zip(w) {
+            *a += b;
+        }
+    }
     let force = pixel_force * hits as f64;
     let coverage = hits as f64 / (nx * ny) as f64;
-    let mut loads: Vec<(usize, [i32; 2], SMatrix<f64, 12, 1>)> = bands
-        .into_iter()
-        .flat_map(|(_, l)| l.into_iter().map(|((e, s), f)| (e, s, f)))
-        .collect();
-    // The balancing body force: per unit fiber volume, integrated with 3-point Gauss (exact for
-    // the cubic shape functions).
+    // The balancing body force: per unit fiber volume, w_e = force · V_e / V on element e,
+    // upwards; its Lagrange weights are ∫ℓ_j = (1, 3, 3, 1)/8 (exact for the cubic shape
+    // functions).
     let volumes: Vec<f64> = els
         .iter()
         .enumerate()
         .map(|(e, el)| model.fibers[el.fiber].section.area() * element_length(model, e))
         .collect();
     let volume: f64 = volumes.iter().sum();
-    if volume > 0.0 && force != 0.0 {
-        let gauss = [
-            (0.5 - 0.5 * 0.6f64.sqrt(), 5.0 / 18.0),
-            (0.5, 8.0 / 18.0),
-            (0.5 + 0.5 * 0.6f64.sqrt(), 5.0 / 18.0),
-        ];
-        for (e, v) in volumes.iter().enumerate() {
-            let w = force * v / volume;
-            let mut f = SMatrix::<f64, 12, 1>::zeros();
-            for (t, weight) in gauss {
-                f += interpolation(e, t).transpose() * Vector3::new(0.0, 0.0, w * weight);
+    let body = |e: usize| {
+        if volume > 0.0 && force != 0.0 {
+            force * volumes[e] / volume
+        } else {
+            0.0
+        }
+    };
+    // Per loaded (element, shift), in that order: the pressure's weights −F W and, on the
+    // unshifted image, the body force's.
+    let mut entries: Vec<(usize, [i32; 2], Weights)> = Vec::with_capacity(images.len());
+    let mut next = 0;
+    for e in 0..els.len() {
+        let w_body = body(e);
+        let mut body_placed = w_body == 0.0;
+        while next < images.len() && images[next].0 == e {
+            let s = images[next].1;
+            if !body_placed && s >= [0, 0] {
+                if s == [0, 0] {
+                    body_placed = true;
+                    let w = weights[next].map(|w| -pixel_force * w);
+                    entries.push((e, s, add_body(w, w_body)));
+                    next += 1;
+                    continue;
+                }
+                entries.push((e, [0, 0], add_body([0.0; 4], w_body)));
+                body_placed = true;
             }
-            loads.push((e, [0, 0], f));
+            if loaded[next] {
+                entries.push((e, s, weights[next].map(|w| -pixel_force * w)));
+            }
+            next += 1;
+        }
+        if !body_placed {
+            entries.push((e, [0, 0], add_body([0.0; 4], w_body)));
         }
     }
-    loads.sort_by_key(|&(e, s, _)| (e, s));
-    let mut merged: Vec<(usize, [i32; 2], SMatrix<f64, 12, 1>)> = Vec::with_capacity(loads.len());
-    for (e, s, f) in loads {
-        match merged.last_mut() {
-            Some(last) if last.0 == e && last.1 == s => last.2 += f,
-            _ => merged.push((e, s, f)),
-        }
-    }
+    let elements = entries
+        .into_par_iter()
+        .map(|(e, s, w)| {
+            let mut f = SMatrix::<f64, 12, 1>::zeros();
+            for (tau, wj) in LAGRANGE_NODES.into_iter().zip(w) {
+                f += interpolation(e, tau).row(2).transpose() * wj;
+            }
+            (e, s, f)
+        })
+        .collect();
     PressureLoad {
-        elements: merged,
+        elements,
         coverage,
         pixel: hx.max(hy),
         force,
     }
+}
+
+/// Sums over an image's pixels of the four cubic Lagrange basis functions on
+/// [`LAGRANGE_NODES`] at the pixels' centerline parameters: Σ_pixels N(t) = Σ_j W_j N(τ_j)
+/// for any cubic N, such as the element's shape functions.
+type Weights = [f64; 4];
+
+/// The nodes τ_j of the cubic Lagrange basis.
+const LAGRANGE_NODES: [f64; 4] = [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0];
+
+/// The cubic Lagrange basis ℓ_j(t) on [`LAGRANGE_NODES`].
+fn lagrange(t: f64) -> Weights {
+    let (a, b, c, d) = (t, t - 1.0 / 3.0, t - 2.0 / 3.0, t - 1.0);
+    [
+        -4.5 * b * c * d,
+        13.5 * a * c * d,
+        -13.5 * a * b * d,
+        4.5 * a * b * c,
+    ]
+}
+
+/// `w` plus an upward body force `w_body` spread with the weights ∫ℓ_j = (1, 3, 3, 1)/8.
+fn add_body(w: Weights, w_body: f64) -> Weights {
+    let simpson = [0.125, 0.375, 0.375, 0.125];
+    std::array::from_fn(|j| w[j] + w_body * simpson[j])
 }
 
 fn element_length(model: &Model, e: usize) -> f64 {
@@ -213,4 +267,45 @@ fn element_length(model: &Model, e: usize) -> f64 {
         .nodes
         .map(|n| Vector3::from(model.nodes[n].x));
     (b - a).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pixel sums go through four Lagrange weights: Σ_i N(t_i) = Σ_j W_j N(τ_j) must hold
+    /// for the element's own (cubic) shape functions, to round-off.
+    #[test]
+    fn lagrange_weights_sum_the_shape_functions_exactly() {
+        let (a, b) = ([0.1, -0.3, 0.2], [1.4, 0.5, -0.6]);
+        let ts: Vec<f64> = (0..37)
+            .map(|i| (f64::from(i) * 0.618_034).fract())
+            .collect();
+        let direct: SMatrix<f64, 3, 12> = ts
+            .iter()
+            .map(|&t| centerline_interpolation(&a, &b, t))
+            .sum();
+        let mut w = [0.0; 4];
+        for &t in &ts {
+            for (wj, lj) in w.iter_mut().zip(lagrange(t)) {
+                *wj += lj;
+            }
+        }
+        let via: SMatrix<f64, 3, 12> = LAGRANGE_NODES
+            .iter()
+            .zip(w)
+            .map(|(&tau, wj)| centerline_interpolation(&a, &b, tau) * wj)
+            .sum();
+        assert!(
+            (direct - via).amax() <= 1e-13 * direct.amax(),
+            "{direct} vs {via}"
+        );
+        // Partition of unity and the integrals of the basis (Simpson's 3/8 rule).
+        assert!((w.iter().sum::<f64>() - ts.len() as f64).abs() < 1e-12);
+        let simpson = add_body([0.0; 4], 1.0);
+        let quad: f64 = (0..1000)
+            .map(|i| lagrange((f64::from(i) + 0.5) / 1000.0)[1] / 1000.0)
+            .sum();
+        assert!((quad - simpson[1]).abs() < 1e-6, "{quad}");
+    }
 }
