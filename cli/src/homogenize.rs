@@ -84,7 +84,7 @@ pub(crate) fn homogenize(
     );
     let t = &h.timings;
     println!(
-        "time (s): setup {:.3}  assembly {:.3}  analysis {:.3}  factorization {:.3}  pressure load {:.3}  7 solves {:.3}  post {:.3}  total {:.3}",
+        "time (s): setup {:.3}  assembly {:.3}  analysis {:.3}  factorization {:.3}  pressure load {:.3} (beside the analysis)  7 solves {:.3}  post {:.3}  total {:.3}",
         t.setup, t.assembly, t.analysis, t.factorization, t.pressure_load, t.solve, t.post, t.total
     );
     Ok(())
