@@ -88,7 +88,8 @@ pub fn backward_from_product(norm_a: f64, ax: &[f64], x: &[f64], b: &[f64]) -> f
 
 /// Solves A X = B with a factorized `solver`, then checks the result: a non-finite solution is
 /// [`SolverError::NonFinite`], and the relative residual of every column is computed and
-/// reported. `b` holds `nrhs` columns of length n.
+/// reported. `b` holds `nrhs` columns of length n. For a symmetric-only backend `a` is taken
+/// to be symmetric, as its analysis required, and its columns are read as rows.
 pub fn solve_checked(
     solver: &mut dyn LinearSolver,
     a: CscRef<'_>,
@@ -105,7 +106,15 @@ pub fn solve_checked(
             index: i % n.max(1),
         });
     }
-    let (norm_a, ax) = rayon::join(|| norm_inf(a), || products(a, &x, nrhs));
+    let (norm_a, ax) = if solver.capabilities().symmetric_only {
+        // A symmetric backend's matrix (its pattern checked symmetric by the analysis): all
+        // columns in one pass over A.
+        let mut ax = vec![0.0; n * nrhs];
+        let norm = a.mul_many_symmetric_norm_par(&x, nrhs, &mut ax);
+        (norm, ax)
+    } else {
+        rayon::join(|| norm_inf(a), || products(a, &x, nrhs))
+    };
     let (relative, backward) = (0..nrhs)
         .into_par_iter()
         .map(|k| {
