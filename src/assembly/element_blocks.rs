@@ -53,7 +53,7 @@ impl ElementBlocks {
         ElementBlocks {
             maps: model
                 .elements()
-                .iter()
+                .par_iter()
                 .map(|e| {
                     if identity {
                         None

@@ -160,7 +160,7 @@ impl StickSystem {
             .collect();
         let elements = ElementBlocks::new(model, &discretization);
         let contacts: Vec<ContactPair> = closed
-            .iter()
+            .par_iter()
             .map(|&i| discretization.contact_pair(&set.pairs[i]))
             .collect();
         let contact_origins = closed.iter().map(|&i| set.origins[i].clone()).collect();
