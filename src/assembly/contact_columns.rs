@@ -8,7 +8,7 @@
 //! are computed as one small product, Bᵀ (S B_a) + Rᵀ (ρ R_a), whose rows the compiler
 //! vectorizes.
 
-use crate::assembly::{prefetch, Pattern, SharedMut, NO_SLOT};
+use crate::assembly::{prefetch, BlockSlots, Pattern, SharedMut, NO_SLOT};
 use crate::constraints::Discretization;
 use crate::contact::{ContactBlock, ContactPair};
 use nalgebra::SMatrix;
@@ -84,7 +84,7 @@ impl ContactColumns {
                 for (d, column) in runs.iter_mut().enumerate() {
                     let c = 6 * a + d;
                     for (b, run) in column.iter_mut().take(m / 6).enumerate() {
-                        *run = Pattern::row_run(slots, m, 6 * b, c).unwrap_or(NO_SLOT);
+                        *run = slots.row_run(6 * b, c).unwrap_or(NO_SLOT);
                     }
                 }
                 incidences[next[g]] = Incidence {
@@ -166,10 +166,9 @@ impl ContactColumns {
                                     }
                                 }
                             } else {
-                                let m = column.len();
                                 let slots = pattern.extra_slots(i);
                                 for (r, k) in (6 * b..6 * b + 6).zip(rows) {
-                                    let slot = slots[r * m + c];
+                                    let slot = slots.get(r, c);
                                     if slot != NO_SLOT {
                                         // SAFETY: as above.
                                         unsafe { *values.get(slot as usize) += k };
@@ -229,15 +228,14 @@ impl ContactColumns {
 pub fn add_contact_block(
     pair: &ContactPair,
     block: &ContactBlock,
-    slots: &[u32],
+    slots: BlockSlots<'_>,
     values: &mut [f64],
 ) {
-    let m = pair.size();
     for a in 0..pair.jump.nodes.len() {
         with_node_columns(pair, block, a, |d, column| {
             let c = 6 * a + d;
             for (r, k) in column.iter().enumerate() {
-                let slot = slots[r * m + c];
+                let slot = slots.get(r, c);
                 if slot != NO_SLOT {
                     values[slot as usize] += k;
                 }
@@ -376,8 +374,8 @@ pub(crate) mod tests {
                             }
                         }
                         (_, false) => {
-                            if slots[r * m + c] != NO_SLOT {
-                                out.values[slots[r * m + c] as usize] += k(r, c);
+                            if slots.get(r, c) != NO_SLOT {
+                                out.values[slots.get(r, c) as usize] += k(r, c);
                             }
                         }
                     }

@@ -159,7 +159,7 @@ impl ElementBlocks {
             let slots = pattern.element_slots(e);
             for r in 0..m {
                 for c in 0..m {
-                    let s = slots[r * m + c];
+                    let s = slots.get(r, c);
                     if s != NO_SLOT {
                         values[s as usize] += k[(r, c)];
                     }

@@ -1,6 +1,6 @@
 //! Value fill of the reduced stiffness through the slot map, serial or parallel.
 
-use super::{color_elements, Pattern, SharedMut, NO_SLOT};
+use super::{color_elements, BlockSlots, Pattern, SharedMut, NO_SLOT};
 use crate::element::{global_stiffness, FrameStiffness, Matrix12};
 use crate::model::{Fiber, Model};
 use fibercell_solver::SolverError;
@@ -42,10 +42,10 @@ pub struct Assembler {
     colors: Vec<Vec<usize>>,
 }
 
-fn scatter(k: &Matrix12, slots: &[u32], mut add: impl FnMut(usize, f64)) {
+fn scatter(k: &Matrix12, slots: BlockSlots<'_>, mut add: impl FnMut(usize, f64)) {
     for r in 0..12 {
         for c in 0..12 {
-            let s = slots[r * 12 + c];
+            let s = slots.get(r, c);
             if s != NO_SLOT {
                 add(s as usize, k[(r, c)]);
             }

@@ -12,7 +12,7 @@ pub use coloring::{color_blocks, color_elements};
 pub use contact_columns::{add_contact_block, ContactColumns};
 pub use element_blocks::{ElementBlocks, InternalForces};
 pub use fill::{element_stiffness, fiber_stiffness, Assembler, FillMode};
-pub use pattern::{Pattern, PatternTooLargeError, NO_SLOT};
+pub use pattern::{BlockSlots, Pattern, PatternTooLargeError, NO_SLOT};
 pub(crate) use shared::{prefetch, SharedMut};
 
 /// A small periodic cell with contacts, for the unit tests of the assembled values.

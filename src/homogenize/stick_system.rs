@@ -3,7 +3,9 @@
 //! a periodic cell's couplings to its drivers. One assembler for the cell problems, the
 //! property checks and the free model's rigid modes.
 
-use crate::assembly::{color_blocks, ContactColumns, ElementBlocks, Pattern, SharedMut, NO_SLOT};
+use crate::assembly::{
+    color_blocks, BlockSlots, ContactColumns, ElementBlocks, Pattern, SharedMut, NO_SLOT,
+};
 use crate::cell::MacroStrain;
 use crate::constraints::Discretization;
 use crate::contact::{ContactOrigin, ContactPair, ContactSet};
@@ -42,7 +44,7 @@ impl Sink<'_> {
         &self,
         gnodes: &[usize],
         k: impl Fn(usize, usize) -> f64,
-        slots: &[u32],
+        slots: BlockSlots<'_>,
     ) -> Option<Matrix6> {
         let m = 6 * gnodes.len();
         if !gnodes.contains(&self.driver) {
@@ -50,7 +52,7 @@ impl Sink<'_> {
             // rows of a column as one run when they are adjacent slots (`Pattern::row_run`).
             for c in 0..m {
                 for r0 in (0..m).step_by(6) {
-                    if let Some(first) = Pattern::row_run(slots, m, r0, c) {
+                    if let Some(first) = slots.row_run(r0, c) {
                         // SAFETY: as below, the slots couple two nodes of this block only.
                         let run = unsafe { self.values.run::<6>(first as usize) };
                         for (d, v) in run.iter_mut().enumerate() {
@@ -59,7 +61,7 @@ impl Sink<'_> {
                         continue;
                     }
                     for r in r0..r0 + 6 {
-                        let s = slots[r * m + c];
+                        let s = slots.get(r, c);
                         if s != NO_SLOT {
                             // SAFETY: as below, the slot couples two nodes of this block only.
                             unsafe { *self.values.get(s as usize) += k(r, c) };
@@ -81,7 +83,7 @@ impl Sink<'_> {
                 }
             }
             (_, false) => {
-                let s = slots[r * m + c];
+                let s = slots.get(r, c);
                 if s != NO_SLOT {
                     // SAFETY: the slot couples two non-driver nodes of this block, which no
                     // other block of its color holds.

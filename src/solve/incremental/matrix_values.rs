@@ -103,21 +103,20 @@ impl MatrixValues {
         }
         self.saved_at[c] = self.saved.len();
         let values = &self.values;
-        self.saved
-            .extend(pattern.extra_slots(c).iter().map(|&slot| {
-                if slot == NO_SLOT {
-                    0.0
-                } else {
-                    values[slot as usize]
-                }
-            }));
+        self.saved.extend(pattern.extra_slots(c).iter().map(|slot| {
+            if slot == NO_SLOT {
+                0.0
+            } else {
+                values[slot as usize]
+            }
+        }));
     }
 
     /// Gives contact `c`'s slots their saved A₀ values.
     fn restore(&mut self, pattern: &Pattern, c: usize) {
         let start = self.saved_at[c];
         let slots = pattern.extra_slots(c);
-        for (&slot, &v) in slots.iter().zip(&self.saved[start..start + slots.len()]) {
+        for (slot, &v) in slots.iter().zip(&self.saved[start..start + slots.len()]) {
             if slot != NO_SLOT {
                 self.values[slot as usize] = v;
             }
