@@ -256,7 +256,7 @@ pub struct BlockSlots<'a> {
 impl<'a> BlockSlots<'a> {
     /// Numbers stored for a block of `k` nodes.
     fn stored(k: usize) -> usize {
-        6 * k + 36 * k * k / 6
+        6 * k * (k + 1)
     }
 
     /// The map stored in `stored` (length [`BlockSlots::stored`]).

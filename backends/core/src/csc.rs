@@ -382,6 +382,10 @@ impl<'a> CscRef<'a> {
         if n == 0 || k == 0 {
             return 0.0;
         }
+        if k == 1 {
+            // The same sums; the one-column loop is a third faster than a group of one.
+            return self.mul_vec_symmetric_norm_par(x, y);
+        }
         // Per chunk of rows: its piece of every column of Y.
         let mut pieces: Vec<Vec<&mut [f64]>> = (0..n.div_ceil(CHUNK))
             .map(|_| Vec::with_capacity(k))
