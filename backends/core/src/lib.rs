@@ -38,7 +38,10 @@ pub use factor_pcg::{pcg_with_factor, FactorPcg};
 pub use forward::{ForwardBlock, ForwardColumns};
 pub use lower::{permuted_diagonal_scale, LowerTriangle};
 pub use matrix_market::{read_matrix_market, read_matrix_market_dense};
-pub use ordering::{compute_ordering, FillEstimate, FillOrdering, NodeGraph, Permutation};
+pub use ordering::{
+    compute_ordering, FillEstimate, FillOrdering, NodeGraph, NodeTree, OrderedNodes, Permutation,
+    ReachPattern, ScalarTree,
+};
 pub use residual::{
     backward_error, backward_from_product, norm_inf, norm_inf_symmetric_par, relative_from_product,
     relative_residual, solve_checked, vector_norm_inf, SolveReport,

@@ -114,7 +114,9 @@ pub fn compute_ordering(
 #[cfg(feature = "metis")]
 mod metis;
 mod node_graph;
-pub use node_graph::{FillEstimate, NodeGraph};
+mod node_tree;
+pub use node_graph::{FillEstimate, NodeGraph, OrderedNodes};
+pub use node_tree::{NodeTree, ReachPattern, ScalarTree};
 
 #[cfg(test)]
 mod tests {

@@ -11,7 +11,7 @@ use crate::block_kernels::{backward_block, top_par, Shared, SolveSchedule};
 use crate::block_tree::BlockTree;
 use crate::dense_forward::DenseForward;
 use crate::prefetch::prefetch_block;
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
+use crate::symbolic::Symbolic;
 use faer::Par;
 use rayon::prelude::*;
 
@@ -19,7 +19,7 @@ use rayon::prelude::*;
 pub(crate) fn solve_in_place(
     tree: &BlockTree,
     schedule: &SolveSchedule,
-    symbolic: &SymbolicCholesky<usize>,
+    symbolic: &Symbolic,
     values: &[f64],
     x: &mut [f64],
 ) {
@@ -31,7 +31,7 @@ pub(crate) fn solve_in_place(
 pub(crate) fn forward_in_place(
     tree: &BlockTree,
     schedule: &SolveSchedule,
-    symbolic: &SymbolicCholesky<usize>,
+    symbolic: &Symbolic,
     values: &[f64],
     x: &mut [f64],
 ) {
@@ -42,7 +42,7 @@ pub(crate) fn forward_in_place(
 pub(crate) fn backward_in_place(
     tree: &BlockTree,
     schedule: &SolveSchedule,
-    symbolic: &SymbolicCholesky<usize>,
+    symbolic: &Symbolic,
     values: &[f64],
     x: &mut [f64],
 ) {

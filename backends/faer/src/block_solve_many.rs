@@ -7,7 +7,7 @@
 
 use crate::block_kernels::{backward_dense, forward_dense, top_par, Shared, SolveSchedule};
 use crate::block_tree::{Block, BlockTree, NONE};
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
+use crate::symbolic::Symbolic;
 use faer::{MatMut, MatRef, Par};
 use rayon::prelude::*;
 
@@ -20,7 +20,7 @@ const DENSE_KERNEL_WORK: usize = 1 << 11;
 pub(crate) struct FactorBlocks<'a> {
     pub(crate) tree: &'a BlockTree,
     pub(crate) schedule: &'a SolveSchedule,
-    pub(crate) symbolic: &'a SymbolicCholesky<usize>,
+    pub(crate) symbolic: &'a Symbolic,
     pub(crate) values: &'a [f64],
 }
 

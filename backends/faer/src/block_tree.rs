@@ -2,7 +2,7 @@
 //! simplicial factor), each block's parent, shape and values — what every half solve and the
 //! sparse forward solves walk. The bottom of the solve modules: it uses none of them.
 
-use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
+use crate::symbolic::{Raw, Symbolic};
 use std::ops::Range;
 
 /// No block (the parent of a root).
@@ -11,7 +11,7 @@ pub(crate) const NONE: usize = usize::MAX;
 /// A numeric LLᵀ factor as the solves read it.
 #[derive(Clone, Copy)]
 pub(crate) struct FactorView<'a> {
-    pub(crate) symbolic: &'a SymbolicCholesky<usize>,
+    pub(crate) symbolic: &'a Symbolic,
     /// The values of L.
     pub(crate) values: &'a [f64],
     /// The inverse fill-reducing permutation, `inv[old] = new`.
@@ -49,9 +49,9 @@ pub(crate) struct BlockShape {
     pub(crate) values: Range<usize>,
 }
 
-fn raw_shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> BlockShape {
+fn raw_shape(symbolic: &Symbolic, s: usize) -> BlockShape {
     match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(f) => {
+        Raw::Simplicial(f) => {
             let (p, q) = (f.col_ptr()[s], f.col_ptr()[s + 1]);
             BlockShape {
                 begin: s,
@@ -60,7 +60,7 @@ fn raw_shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> BlockShape {
                 values: p..q,
             }
         }
-        SymbolicCholeskyRaw::Supernodal(f) => {
+        Raw::Supernodal(f) => {
             let begin = f.supernode_begin()[s];
             let first = f.col_ptr_for_row_idx()[s];
             BlockShape {
@@ -74,23 +74,23 @@ fn raw_shape(symbolic: &SymbolicCholesky<usize>, s: usize) -> BlockShape {
 }
 
 /// The row indices the block patterns index into.
-pub(crate) fn row_idx(symbolic: &SymbolicCholesky<usize>) -> &[usize] {
+pub(crate) fn row_idx(symbolic: &Symbolic) -> &[usize] {
     match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(f) => f.row_idx(),
-        SymbolicCholeskyRaw::Supernodal(f) => f.row_idx(),
+        Raw::Simplicial(f) => f.row_idx(),
+        Raw::Supernodal(f) => f.row_idx(),
     }
 }
 
-fn block_count(symbolic: &SymbolicCholesky<usize>) -> usize {
+fn block_count(symbolic: &Symbolic) -> usize {
     match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(f) => f.ncols(),
-        SymbolicCholeskyRaw::Supernodal(f) => f.n_supernodes(),
+        Raw::Simplicial(f) => f.ncols(),
+        Raw::Supernodal(f) => f.n_supernodes(),
     }
 }
 
 impl BlockTree {
     /// The tree of `symbolic` (its values are not read).
-    pub(crate) fn of(symbolic: &SymbolicCholesky<usize>) -> Self {
+    pub(crate) fn of(symbolic: &Symbolic) -> Self {
         let n = symbolic.nrows();
         let blocks = block_count(symbolic);
         let mut block_of = vec![NONE; n];
@@ -118,7 +118,7 @@ impl BlockTree {
     /// Block `s` of the factor with values `values`.
     pub(crate) fn block<'a>(
         &self,
-        symbolic: &'a SymbolicCholesky<usize>,
+        symbolic: &'a Symbolic,
         values: &'a [f64],
         s: usize,
     ) -> Block<'a> {

@@ -12,20 +12,21 @@ use crate::block_tree::{BlockTree, FactorView};
 use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
 use crate::supernodal_llt::{self, ScaledMatrix, SupernodalPlan, TaskSizes};
-use faer::dyn_stack::{MemBuffer, MemStack};
+use crate::symbolic::{supernodal_of_node_tree, Raw, Symbolic};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, supernodal, CholeskySymbolicParams, LdltRef, LltRef,
-    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    SymbolicCholesky, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use fibercell_solver::{
     compute_ordering, permuted_diagonal_scale, AnalyzeInfo, Capabilities, CscRef, FillEstimate,
-    FillOrdering, ForwardColumns, LinearSolver, LowerTriangle, NodeGraph, PatternFingerprint,
-    Permutation, SolveInfo, SolverError,
+    FillOrdering, ForwardColumns, LinearSolver, LowerTriangle, NodeGraph, NodeTree,
+    PatternFingerprint, Permutation, SolveInfo, SolverError,
 };
 use std::sync::Arc;
 
@@ -100,7 +101,7 @@ struct Analysis {
     fingerprint: PatternFingerprint,
     /// The permutation faer factorizes with (`fwd[new] = old`).
     perm: Permutation,
-    symbolic: SymbolicCholesky<usize>,
+    symbolic: Symbolic,
     /// The block tree of L for sparse forward solves.
     tree: BlockTree,
     /// Its blocks per thread for solves with one right-hand side.
@@ -252,25 +253,52 @@ impl FaerCholesky {
         self
     }
 
-    /// The fill-reducing permutation of `a` (checked structurally symmetric) and its name.
-    /// AMD and nested dissection run on the node graph; Auto takes the one with fewer flops
-    /// predicted there, so only the winner gets a scalar symbolic factorization. The fill of an
-    /// ordering computed on the node graph is the factor's exact structure.
+    /// The fill-reducing permutation of `a` (checked structurally symmetric), its name and,
+    /// for an ordering made on the node graph (AMD, nested dissection, Auto: the one with
+    /// fewer flops predicted there), the graph with the order's tree and fill — the factor's
+    /// exact structure.
     fn permutation(
         &self,
         a: CscRef<'_>,
-    ) -> Result<(Permutation, String, Option<FillEstimate>), SolverError> {
+    ) -> Result<(Permutation, String, Option<NodeOrder>), SolverError> {
         match &self.ordering {
             o @ (FillOrdering::Auto | FillOrdering::Amd | FillOrdering::NestedDissection) => {
-                let (p, fill, chosen) = NodeGraph::of_checked(a).order(o)?;
+                let graph = NodeGraph::of_checked(a);
+                let ordered = graph.ordered(o)?;
                 let name = match o {
-                    FillOrdering::Auto => format!("auto→{}", chosen.name()),
+                    FillOrdering::Auto => format!("auto→{}", ordered.chosen.name()),
                     o => o.name().to_string(),
                 };
-                Ok((p, name, Some(fill)))
+                let order = NodeOrder {
+                    graph,
+                    tree: ordered.tree,
+                    fill: ordered.fill,
+                };
+                Ok((ordered.permutation, name, Some(order)))
             }
             o => Ok((compute_ordering(a, o)?, o.name().to_string(), None)),
         }
+    }
+
+    /// The symbolic factor of `a` under `perm`: faer's supernodal step on the node tree where
+    /// the ordering was made on the node graph and the factor is supernodal, else faer's own
+    /// analysis.
+    fn symbolic(
+        &self,
+        a: CscRef<'_>,
+        perm: &Permutation,
+        order: Option<&NodeOrder>,
+    ) -> Result<Symbolic, SolverError> {
+        if let Some(o) = order {
+            if let Some(sn) = supernodal_of_node_tree(&o.graph, &o.tree)? {
+                return Ok(Symbolic::Supernodal(sn));
+            }
+        }
+        // faer reads the lower triangle of the pattern it is given (its entries with row ≥
+        // column), so A's own pattern serves.
+        let n = a.ncols();
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
+        self.symbolic_for(pattern, perm).map(Symbolic::Faer)
     }
 
     fn symbolic_for(
@@ -294,6 +322,13 @@ impl FaerCholesky {
     }
 }
 
+/// An ordering made on the node graph: the graph, the order's elimination tree and its fill.
+struct NodeOrder {
+    graph: NodeGraph,
+    tree: NodeTree,
+    fill: FillEstimate,
+}
+
 /// Factor values × right-hand sides below which a solve stays on the calling thread (about
 /// 100 µs of work; waking another thread costs microseconds).
 const PARALLEL_SOLVE_VALUES: usize = 1 << 18;
@@ -308,7 +343,7 @@ fn factorize_with_tasks(
     pivot_tolerance: f64,
     par: Par,
 ) -> Result<Factor, SolverError> {
-    let SymbolicCholeskyRaw::Supernodal(sn) = an.symbolic.raw() else {
+    let Some(sn) = an.symbolic.supernodal() else {
         return Err(SolverError::Backend {
             backend: "faer-cholesky",
             code: -3,
@@ -342,6 +377,32 @@ fn threads(par: Par) -> usize {
     }
 }
 
+/// The column groups of `x` (n rows, `per_group` columns each) through `solve`, side by side
+/// when `parallel`, each with its own `scratch(columns)` workspace.
+fn solve_groups(
+    x: &mut [f64],
+    (n, per_group): (usize, usize),
+    parallel: bool,
+    scratch: impl Fn(usize) -> StackReq + Sync,
+    solve: impl Fn(MatMut<'_, f64>, &mut MemStack) + Sync,
+) -> Result<(), SolverError> {
+    let group = |block: &mut [f64]| -> Result<(), SolverError> {
+        let k = block.len() / n;
+        let mut buf = MemBuffer::try_new(scratch(k)).map_err(|_| SolverError::OutOfMemory)?;
+        solve(
+            MatMut::from_column_major_slice_mut(block, n, k),
+            MemStack::new(&mut buf),
+        );
+        Ok(())
+    };
+    if parallel {
+        use rayon::prelude::*;
+        x.par_chunks_mut(per_group * n).try_for_each(group)
+    } else {
+        group(x)
+    }
+}
+
 fn pivot_error(column: usize, pivot: f64) -> SolverError {
     SolverError::NotPositiveDefinite { column, pivot }
 }
@@ -362,20 +423,19 @@ impl LinearSolver for FaerCholesky {
         self.workspace = None;
         self.prefaulted = None;
         let n = a.ncols();
-        let (perm, name, fill) = self.permutation(a)?;
+        let (perm, name, order) = self.permutation(a)?;
+        let fill = order.as_ref().map(|o| o.fill);
         // faer stores each supernode's diagonal block square and relaxed zeros: its values
         // exceed nnz(L) by ≈ 25 % on the generated cells, hence the capacity.
         self.prefaulted = fill.and_then(|f| {
             (8 * f.nnz_l >= self.prefault_bytes)
                 .then(|| PrefaultedValues::start(f.nnz_l, f.nnz_l + f.nnz_l / 2))
         });
-        // faer reads the lower triangle of the pattern it is given (its entries with row ≥
-        // column), so A's own pattern serves.
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.col_ptr(), None, a.row_idx());
-        let symbolic = self.symbolic_for(pattern, &perm).inspect_err(|_| {
+        let symbolic = self.symbolic(a, &perm, order.as_ref()).inspect_err(|_| {
             // The buffer's thread detaches and frees it when done.
             self.prefaulted = None;
         })?;
+        drop(order);
         // faer's supernodes store explicit zeros where they were relaxed; nnz(L) and the
         // flops are the structure's (from the node graph, else faer's column counts).
         let (nnz_l, flops) = fill.map_or_else(|| fill_and_flops(&symbolic), |f| (f.nnz_l, f.flops));
@@ -388,12 +448,15 @@ impl LinearSolver for FaerCholesky {
             flops: Some(flops),
             ordering: name,
         };
-        let (factor_fwd, factor_inv) = match symbolic.perm() {
-            Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
-            None => ((0..n).collect(), (0..n).collect()),
+        let (factor_fwd, factor_inv) = match &symbolic {
+            Symbolic::Faer(s) => match s.perm() {
+                Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
+                None => ((0..n).collect(), (0..n).collect()),
+            },
+            Symbolic::Supernodal(_) => (perm.fwd.clone(), perm.inv.clone()),
         };
         let plan = match (self.variant, symbolic.raw()) {
-            (CholeskyVariant::Llt, SymbolicCholeskyRaw::Supernodal(sn)) => {
+            (CholeskyVariant::Llt, Raw::Supernodal(sn)) => {
                 SupernodalPlan::new(sn, threads(self.par), TaskSizes::default())
             }
             _ => None,
@@ -452,14 +515,14 @@ impl LinearSolver for FaerCholesky {
             Some(ws) => ws,
             None => {
                 let req = match (self.variant, an.symbolic.raw()) {
-                    (CholeskyVariant::Llt, SymbolicCholeskyRaw::Supernodal(sn)) => {
+                    (CholeskyVariant::Llt, Raw::Supernodal(sn)) => {
                         supernodal::factorize_supernodal_numeric_llt_scratch::<usize, f64>(
                             sn,
                             self.par,
                             Spec::default(),
                         )
                     }
-                    (CholeskyVariant::Ldlt, SymbolicCholeskyRaw::Supernodal(sn)) => {
+                    (CholeskyVariant::Ldlt, Raw::Supernodal(sn)) => {
                         supernodal::factorize_supernodal_numeric_ldlt_scratch::<usize, f64>(
                             sn,
                             self.par,
@@ -468,9 +531,11 @@ impl LinearSolver for FaerCholesky {
                     }
                     (CholeskyVariant::Llt, _) => an
                         .symbolic
+                        .faer()?
                         .factorize_numeric_llt_scratch::<f64>(self.par, Spec::default()),
                     (CholeskyVariant::Ldlt, _) => an
                         .symbolic
+                        .faer()?
                         .factorize_numeric_ldlt_scratch::<f64>(self.par, Spec::default()),
                 };
                 Workspace {
@@ -479,10 +544,7 @@ impl LinearSolver for FaerCholesky {
                 }
             }
         };
-        let supernodal = match an.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(sn) => Some(sn),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
-        };
+        let supernodal = an.symbolic.supernodal();
         if supernodal.is_some() {
             lower.scaled_permuted_values(a, &an.factor_fwd, &mut f.scale, &mut ws.lower_values)?;
         } else {
@@ -518,6 +580,7 @@ impl LinearSolver for FaerCholesky {
                     )
                     .map(|_| ()),
                     None => sym
+                        .faer()?
                         .factorize_numeric_llt(
                             &mut f.l_values,
                             lower,
@@ -547,6 +610,7 @@ impl LinearSolver for FaerCholesky {
                     )
                     .map(|_| ()),
                     None => sym
+                        .faer()?
                         .factorize_numeric_ldlt(
                             &mut f.l_values,
                             lower,
@@ -635,9 +699,6 @@ impl LinearSolver for FaerCholesky {
             permute::many_from_factor_order(&x, nrhs, &f.scale, &an.factor_inv, rhs);
             return Ok(SolveInfo::default());
         }
-        for col in rhs.chunks_mut(n) {
-            col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
-        }
         // Several right-hand sides: column groups solved side by side, one per thread (faer's
         // supernodal solve gains little from more columns at a time or from a parallel kernel);
         // on the calling thread alone when the solves are too small to hand to another.
@@ -655,30 +716,58 @@ impl LinearSolver for FaerCholesky {
             (self.par, nrhs)
         };
         let variant = self.variant;
-        let solve_group = |block: &mut [f64]| -> Result<(), SolverError> {
-            let k = block.len() / n;
-            let req = an.symbolic.solve_in_place_scratch::<f64>(k, par);
-            let mut buf = MemBuffer::try_new(req).map_err(|_| SolverError::OutOfMemory)?;
-            let stack = MemStack::new(&mut buf);
-            let mat = MatMut::from_column_major_slice_mut(block, n, k);
-            match variant {
-                CholeskyVariant::Llt => LltRef::new(&an.symbolic, &f.l_values)
-                    .solve_in_place_with_conj(Conj::No, mat, par, stack),
-                CholeskyVariant::Ldlt => LdltRef::new(&an.symbolic, &f.l_values)
-                    .solve_in_place_with_conj(Conj::No, mat, par, stack),
+        match an.symbolic.raw() {
+            Raw::Supernodal(sn) => {
+                // faer's supernodal solve in the factor's order: columns permuted and scaled
+                // into a copy, solved, and back.
+                let mut x = vec![0.0; n * nrhs];
+                let parallel = threads > 1;
+                for (b, y) in rhs.chunks(n).zip(x.chunks_mut(n)) {
+                    permute::into_factor_order(b, &f.scale, &an.factor_fwd, y, parallel);
+                }
+                let values = &f.l_values[..];
+                solve_groups(
+                    &mut x,
+                    (n, per_group),
+                    groups > 1,
+                    |k| sn.solve_in_place_scratch::<f64>(k, par),
+                    |mat, stack| match variant {
+                        CholeskyVariant::Llt => supernodal::SupernodalLltRef::new(sn, values)
+                            .solve_in_place_with_conj(Conj::No, mat, par, stack),
+                        CholeskyVariant::Ldlt => supernodal::SupernodalLdltRef::new(sn, values)
+                            .solve_in_place_with_conj(Conj::No, mat, par, stack),
+                    },
+                )?;
+                for (y, b) in x.chunks(n).zip(rhs.chunks_mut(n)) {
+                    permute::from_factor_order(y, &f.scale, &an.factor_inv, b, parallel);
+                }
             }
-            Ok(())
-        };
-        if groups > 1 {
-            use rayon::prelude::*;
-            rhs.par_chunks_mut(per_group * n)
-                .map(solve_group)
-                .collect::<Result<Vec<()>, SolverError>>()?;
-        } else {
-            solve_group(rhs)?;
-        }
-        for col in rhs.chunks_mut(n) {
-            col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
+            Raw::Simplicial(_) => {
+                let sym = an.symbolic.faer()?;
+                for col in rhs.chunks_mut(n) {
+                    col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
+                }
+                let values = &f.l_values[..];
+                solve_groups(
+                    rhs,
+                    (n, per_group),
+                    groups > 1,
+                    |k| sym.solve_in_place_scratch::<f64>(k, par),
+                    |mat, stack| match variant {
+                        CholeskyVariant::Llt => LltRef::new(sym, values).solve_in_place_with_conj(
+                            Conj::No,
+                            mat,
+                            par,
+                            stack,
+                        ),
+                        CholeskyVariant::Ldlt => LdltRef::new(sym, values)
+                            .solve_in_place_with_conj(Conj::No, mat, par, stack),
+                    },
+                )?;
+                for col in rhs.chunks_mut(n) {
+                    col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
+                }
+            }
         }
         Ok(SolveInfo::default())
     }
@@ -729,13 +818,66 @@ impl LinearSolver for FaerCholesky {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_matrices::{grid, grid_factor};
+    use crate::test_matrices::{blocked_network, grid, grid_factor};
+    use fibercell_solver::CscMatrix;
 
     /// The solution of `solver` for `b`, one right-hand side.
     fn solved(solver: &mut dyn LinearSolver, b: &[f64]) -> Vec<f64> {
         let mut x = b.to_vec();
         solver.solve_in_place(&mut x, 1).unwrap();
         x
+    }
+
+    /// ‖A x − b‖∞ / ‖b‖∞.
+    fn relative_residual(a: &CscMatrix, x: &[f64], b: &[f64]) -> f64 {
+        let a = a.as_ref();
+        let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
+        for (j, xj) in x.iter().enumerate() {
+            let (rows, values) = a.col(j);
+            for (&i, v) in rows.iter().zip(values) {
+                r[i] += v * xj;
+            }
+        }
+        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        norm(&r) / norm(b)
+    }
+
+    /// On a network of mixed node widths the analysis takes the node tree's supernodal
+    /// structure, and one, three and five right-hand sides (faer's supernodal solve in the
+    /// factor's order) solve A x = b for LLᵀ and LDLᵀ, column for column alike.
+    #[test]
+    fn the_node_tree_structure_factorizes_and_solves() {
+        let a = blocked_network(400);
+        let n = a.as_ref().ncols();
+        for variant in [CholeskyVariant::Llt, CholeskyVariant::Ldlt] {
+            let mut s = FaerCholesky::new(variant, FillOrdering::Auto);
+            s.analyze(a.as_ref()).unwrap();
+            let an = s.analysis.as_ref().unwrap();
+            assert!(
+                matches!(an.symbolic, Symbolic::Supernodal(_)),
+                "{variant:?}"
+            );
+            s.factorize(a.as_ref()).unwrap();
+            for k in [1, 3, 5] {
+                let b: Vec<f64> = (0..n * k).map(|i| ((i * 37) % 101) as f64 - 50.0).collect();
+                let mut x = b.clone();
+                s.solve_in_place(&mut x, k).unwrap();
+                for (c, (xc, bc)) in x.chunks(n).zip(b.chunks(n)).enumerate() {
+                    let r = relative_residual(&a, xc, bc);
+                    assert!(r < 1e-12, "{variant:?}, {k} columns, column {c}: {r:e}");
+                    let one = solved(&mut s, bc);
+                    let diff = one
+                        .iter()
+                        .zip(xc)
+                        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+                    let scale = one.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                    assert!(
+                        diff <= 1e-12 * scale,
+                        "{variant:?}, {k} columns, column {c}"
+                    );
+                }
+            }
+        }
     }
 
     /// A factorization into the prefaulted buffer (every analysis given one) equals one into
@@ -772,7 +914,7 @@ mod tests {
         s.factorize(a.as_ref()).unwrap();
         assert_eq!(s.is_supernodal(), Some(true));
         let view = s.factor_view();
-        let SymbolicCholeskyRaw::Supernodal(sn) = view.symbolic.raw() else {
+        let Raw::Supernodal(sn) = view.symbolic.raw() else {
             unreachable!("checked supernodal")
         };
         let (mut structural, mut lower) = (0, 0);

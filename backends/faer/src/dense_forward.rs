@@ -10,7 +10,7 @@
 use crate::block_kernels::{forward_block, top_par, Shared, SolveSchedule};
 use crate::block_tree::{BlockTree, NONE};
 use crate::prefetch::prefetch_block;
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
+use crate::symbolic::Symbolic;
 use faer::Par;
 use rayon::prelude::*;
 use std::marker::PhantomData;
@@ -19,7 +19,7 @@ use std::marker::PhantomData;
 pub(crate) struct DenseForward<'a> {
     tree: &'a BlockTree,
     schedule: &'a SolveSchedule,
-    symbolic: &'a SymbolicCholesky<usize>,
+    symbolic: &'a Symbolic,
     values: &'a [f64],
     x: &'a mut [f64],
 }
@@ -28,7 +28,7 @@ pub(crate) struct DenseForward<'a> {
 pub(crate) struct ForwardCursor<'a> {
     tree: &'a BlockTree,
     schedule: &'a SolveSchedule,
-    symbolic: &'a SymbolicCholesky<usize>,
+    symbolic: &'a Symbolic,
     values: &'a [f64],
     /// The group's blocks, ascending (children before parents).
     blocks: &'a [usize],
@@ -48,7 +48,7 @@ impl<'a> DenseForward<'a> {
     pub(crate) fn new(
         tree: &'a BlockTree,
         schedule: &'a SolveSchedule,
-        symbolic: &'a SymbolicCholesky<usize>,
+        symbolic: &'a Symbolic,
         values: &'a [f64],
         x: &'a mut [f64],
     ) -> Self {

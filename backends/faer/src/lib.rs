@@ -42,6 +42,7 @@ mod pivots;
 mod prefetch;
 mod sparse_forward;
 mod supernodal_llt;
+mod symbolic;
 #[cfg(test)]
 mod test_matrices;
 mod top_columns;

@@ -1,8 +1,8 @@
 //! Reading the pivots back out of a faer Cholesky factor, to catch (near-)zero pivots that
 //! faer accepts, and to count fill and flops.
 
+use crate::symbolic::{Raw, Symbolic};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
-use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 
 type SupernodalSymbolic = SymbolicSupernodalCholesky<usize>;
 
@@ -18,17 +18,17 @@ pub(crate) fn supernodes(
 }
 
 /// Entries per column of L (diagonal included), in factor (permuted) order.
-pub(crate) fn column_counts(symbolic: &SymbolicCholesky<usize>) -> Vec<usize> {
+pub(crate) fn column_counts(symbolic: &Symbolic) -> Vec<usize> {
     match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr().windows(2).map(|w| w[1] - w[0]).collect(),
-        SymbolicCholeskyRaw::Supernodal(s) => supernodes(s)
+        Raw::Simplicial(s) => s.col_ptr().windows(2).map(|w| w[1] - w[0]).collect(),
+        Raw::Supernodal(s) => supernodes(s)
             .flat_map(|(b, e, rows, _)| (0..e - b).map(move |c| rows - c))
             .collect(),
     }
 }
 
 /// nnz(L) and the flop count Σ c_j² of a left-looking Cholesky with column counts c_j.
-pub(crate) fn fill_and_flops(symbolic: &SymbolicCholesky<usize>) -> (usize, f64) {
+pub(crate) fn fill_and_flops(symbolic: &Symbolic) -> (usize, f64) {
     let c = column_counts(symbolic);
     (
         c.iter().sum(),
@@ -37,19 +37,19 @@ pub(crate) fn fill_and_flops(symbolic: &SymbolicCholesky<usize>) -> (usize, f64)
 }
 
 /// The diagonal entries of the factor values (L_jj for LLᵀ, D_j for LDLᵀ), in factor order.
-pub(crate) fn factor_diagonal(symbolic: &SymbolicCholesky<usize>, values: &[f64]) -> Vec<f64> {
+pub(crate) fn factor_diagonal(symbolic: &Symbolic, values: &[f64]) -> Vec<f64> {
     match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..s.ncols()]
+        Raw::Simplicial(s) => s.col_ptr()[..s.ncols()]
             .iter()
             .map(|&p| values[p])
             .collect(),
-        SymbolicCholeskyRaw::Supernodal(s) => supernodes(s)
+        Raw::Supernodal(s) => supernodes(s)
             .flat_map(|(b, e, rows, start)| (0..e - b).map(move |c| values[start + c * rows + c]))
             .collect(),
     }
 }
 
 /// Whether faer chose the simplicial variant (its pivot error index is then one-based).
-pub(crate) fn is_simplicial(symbolic: &SymbolicCholesky<usize>) -> bool {
-    matches!(symbolic.raw(), SymbolicCholeskyRaw::Simplicial(_))
+pub(crate) fn is_simplicial(symbolic: &Symbolic) -> bool {
+    matches!(symbolic.raw(), Raw::Simplicial(_))
 }

@@ -5,11 +5,11 @@ use crate::block_kernels::SolveSchedule;
 use crate::block_tree::{row_idx, BlockTree, FactorView, NONE};
 use crate::column_layout::ColumnLayout;
 use crate::dense_forward::{DenseForward, ForwardCursor};
+use crate::symbolic::Symbolic;
 use crate::top_columns::TopColumns;
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{Reborrow, ReborrowMut};
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::{Accum, MatMut, MatRef, Par};
 use fibercell_solver::{ForwardBlock, ForwardColumns, SolverError};
 use rayon::prelude::*;
@@ -228,7 +228,7 @@ impl BlockTree {
     /// are among those of the child it lies under) — where that saves flops.
     fn column_layouts(
         &self,
-        symbolic: &SymbolicCholesky<usize>,
+        symbolic: &Symbolic,
         columns: &[Vec<(usize, f64)>],
         inv: &[usize],
         touched: &[usize],
@@ -355,7 +355,7 @@ fn balanced(loads: &[usize]) -> bool {
 /// What eliminating the touched blocks of one group needs.
 struct Walk<'a> {
     tree: &'a BlockTree,
-    symbolic: &'a SymbolicCholesky<usize>,
+    symbolic: &'a Symbolic,
     values: &'a [f64],
     /// The touched blocks, ascending.
     touched: &'a [usize],

@@ -45,3 +45,51 @@ pub(crate) fn grid(k: usize) -> CscMatrix {
     }
     CscMatrix::from_triplets(k * k * k, k * k * k, &t).unwrap()
 }
+
+/// A fiber-like network: a ring of `m` nodes of widths 1–6 with chords from hashes of the node number,
+/// every node's and every edge's block dense, diagonally dominant (SPD).
+pub(crate) fn blocked_network(m: usize) -> CscMatrix {
+    // Hashes of the node number stand in for random widths and chords.
+    let hash = |g: usize, salt: u64| {
+        let x = (g as u64 ^ (salt << 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        ((x ^ (x >> 29)).wrapping_mul(0xBF58_476D_1CE4_E5B9) >> 32) as usize
+    };
+    let widths: Vec<usize> = (0..m).map(|g| 1 + hash(g, 11) % 6).collect();
+    let mut start = vec![0];
+    for w in &widths {
+        start.push(start.last().unwrap() + w);
+    }
+    let mut edges: Vec<(usize, usize)> = (0..m).map(|g| (g, (g + 1) % m)).collect();
+    edges.extend((0..m).map(|g| (hash(g, 23) % m, hash(g, 47) % m)));
+    edges.retain(|&(g, h)| g != h);
+    let n = start[m];
+    let mut t = Vec::new();
+    let mut diag = vec![1.0; n];
+    for g in 0..m {
+        // The node's own block: the pairs within it.
+        for i in start[g]..start[g + 1] {
+            for j in start[g]..i {
+                let v = 0.05;
+                t.push((i, j, v));
+                t.push((j, i, v));
+                diag[i] += v;
+                diag[j] += v;
+            }
+        }
+    }
+    for &(g, h) in &edges {
+        for i in start[g]..start[g + 1] {
+            for j in start[h]..start[h + 1] {
+                let v = -0.1 - ((i * 31 + j * 17) % 11) as f64 / 20.0;
+                t.push((i, j, v));
+                t.push((j, i, v));
+                diag[i] += v.abs();
+                diag[j] += v.abs();
+            }
+        }
+    }
+    for (i, d) in diag.iter().enumerate() {
+        t.push((i, i, *d));
+    }
+    CscMatrix::from_triplets(n, n, &t).unwrap()
+}

@@ -9,6 +9,7 @@
 //! candidate follow exactly from the node graph's elimination tree, without a scalar symbolic
 //! factorization.
 
+use super::node_tree::NodeTree;
 use super::{FillOrdering, Permutation};
 use crate::{CscRef, SolverError};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -42,6 +43,16 @@ struct Candidate {
     nodes: Vec<usize>,
     tree: (Vec<usize>, Vec<usize>),
     fill: FillEstimate,
+}
+
+/// A node graph's ordering: the scalar permutation, its fill, the ordering chosen and the
+/// node order's elimination tree ([`NodeGraph::ordered`]).
+#[derive(Clone, Debug)]
+pub struct OrderedNodes {
+    pub permutation: Permutation,
+    pub fill: FillEstimate,
+    pub chosen: FillOrdering,
+    pub tree: NodeTree,
 }
 
 /// The fill a node ordering predicts for the scalar matrix's Cholesky factor (exact for the
@@ -126,10 +137,19 @@ impl NodeGraph {
         &self,
         ordering: &FillOrdering,
     ) -> Result<(Permutation, FillEstimate, FillOrdering), SolverError> {
-        let nodes = match ordering {
-            FillOrdering::Amd => self.amd()?,
-            FillOrdering::NestedDissection => self.nested_dissection()?,
-            FillOrdering::Auto => return self.better_of_amd_and_nested_dissection(),
+        self.ordered(ordering)
+            .map(|o| (o.permutation, o.fill, o.chosen))
+    }
+
+    /// [`NodeGraph::order`] with the node order's elimination tree (postordered).
+    pub fn ordered(&self, ordering: &FillOrdering) -> Result<OrderedNodes, SolverError> {
+        let (best, chosen) = match ordering {
+            FillOrdering::Amd => (self.candidate(self.amd()?), FillOrdering::Amd),
+            FillOrdering::NestedDissection => (
+                self.candidate(self.nested_dissection()?),
+                FillOrdering::NestedDissection,
+            ),
+            FillOrdering::Auto => self.better_of_amd_and_nested_dissection()?,
             FillOrdering::Natural | FillOrdering::Given(_) => {
                 return Err(SolverError::InvalidMatrix(format!(
                     "the {} ordering is not computed on the node graph",
@@ -137,26 +157,27 @@ impl NodeGraph {
                 )))
             }
         };
-        let c = self.candidate(nodes);
-        Ok((
-            self.expand(&self.postordered_of(&c.nodes, &c.tree))?,
-            c.fill,
-            ordering.clone(),
-        ))
+        let tree = self.postordered_of(&best.nodes, &best.tree);
+        Ok(OrderedNodes {
+            permutation: self.expand(tree.nodes())?,
+            fill: best.fill,
+            chosen,
+            tree,
+        })
     }
 
     /// Both candidates side by side (METIS and AMD are sequential); without METIS (the
     /// `metis` feature) AMD alone.
     fn better_of_amd_and_nested_dissection(
         &self,
-    ) -> Result<(Permutation, FillEstimate, FillOrdering), SolverError> {
+    ) -> Result<(Candidate, FillOrdering), SolverError> {
         // AMD is the faster: its tree and fill are made on its thread while METIS runs.
         let (amd, nd) = rayon::join(
             || self.amd().map(|o| self.candidate(o)),
             || self.nested_dissection(),
         );
         let amd = amd?;
-        let (best, chosen) = match nd {
+        Ok(match nd {
             Err(SolverError::Unavailable { .. }) => (amd, FillOrdering::Amd),
             nd => {
                 let nd = self.candidate(nd?);
@@ -166,9 +187,7 @@ impl NodeGraph {
                     (amd, FillOrdering::Amd)
                 }
             }
-        };
-        let nodes = self.postordered_of(&best.nodes, &best.tree);
-        Ok((self.expand(&nodes)?, best.fill, chosen))
+        })
     }
 
     /// The scalar permutation of a node order (`nodes[new] = old node`): each node's columns
@@ -367,14 +386,16 @@ impl NodeGraph {
     /// amalgamation merges the most.
     pub fn postordered(&self, nodes: &[usize]) -> Vec<usize> {
         self.postordered_of(nodes, &self.tree_and_counts(nodes))
+            .nodes
     }
 
-    /// [`NodeGraph::postordered`] from the order's tree and counts.
+    /// [`NodeGraph::postordered`] from the order's tree and counts, with the tree renumbered
+    /// to the postorder.
     fn postordered_of(
         &self,
         nodes: &[usize],
         (parent, below): &(Vec<usize>, Vec<usize>),
-    ) -> Vec<usize> {
+    ) -> NodeTree {
         let m = nodes.len();
         let count = |j: usize| below[j] + self.weight(nodes[j]);
         // Children lists, each by ascending count (a stable sort of the positions by count,
@@ -390,6 +411,8 @@ impl NodeGraph {
                 head[p] = j;
             }
         }
+        // `post[j]`: the new position of position j.
+        let mut post = vec![0usize; m];
         let mut out = Vec::with_capacity(m);
         let mut stack = Vec::new();
         for root in (0..m).filter(|&j| parent[j] == j) {
@@ -397,6 +420,7 @@ impl NodeGraph {
             while let Some(&j) = stack.last() {
                 let c = head[j];
                 if c == usize::MAX {
+                    post[j] = out.len();
                     out.push(nodes[j]);
                     stack.pop();
                 } else {
@@ -405,7 +429,16 @@ impl NodeGraph {
                 }
             }
         }
-        out
+        let mut tree = NodeTree {
+            nodes: out,
+            parent: vec![0; m],
+            below: vec![0; m],
+        };
+        for j in 0..m {
+            tree.parent[post[j]] = post[parent[j]];
+            tree.below[post[j]] = below[j];
+        }
+        tree
     }
 
     /// Parent of each node in the elimination tree of the permuted node graph (Liu's algorithm
@@ -487,8 +520,8 @@ mod tests {
         blocked(&widths, &edges)
     }
 
-    /// nnz(L) and Σ c² of the scalar factor under `p`, by faer's own column counts.
-    fn scalar_fill(a: &CscMatrix, p: &Permutation) -> FillEstimate {
+    /// faer's elimination tree and column counts of the scalar matrix under `p`.
+    fn scalar_tree(a: &CscMatrix, p: &Permutation) -> (Vec<isize>, Vec<usize>) {
         let a = a.as_ref();
         let n = a.ncols();
         let mut t = Vec::new();
@@ -507,6 +540,12 @@ mod tests {
         let mut counts = vec![0usize; n];
         let mut buf = MemBuffer::new(faer::dyn_stack::StackReq::new::<usize>(n));
         prefactorize_symbolic_cholesky(&mut etree, &mut counts, pattern, MemStack::new(&mut buf));
+        (etree, counts)
+    }
+
+    /// nnz(L) and Σ c² of the scalar factor under `p`, by faer's own column counts.
+    fn scalar_fill(a: &CscMatrix, p: &Permutation) -> FillEstimate {
+        let (_, counts) = scalar_tree(a, p);
         FillEstimate {
             nnz_l: counts.iter().sum(),
             flops: counts.iter().map(|&c| (c * c) as f64).sum(),
@@ -657,6 +696,51 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The node tree expanded is faer's scalar elimination tree and column counts of the
+    /// permuted matrix, entry for entry, for every ordering and on graphs of mixed widths.
+    #[test]
+    fn the_expanded_node_tree_is_the_scalar_tree() {
+        for m in [1, 2, 17, 200] {
+            let a = scattered(m);
+            let g = NodeGraph::of(a.as_ref()).unwrap();
+            let mut orderings = vec![FillOrdering::Amd, FillOrdering::Auto];
+            if cfg!(feature = "metis") {
+                orderings.push(FillOrdering::NestedDissection);
+            }
+            for o in orderings {
+                let ordered = g.ordered(&o).unwrap();
+                let t = ordered.tree.scalar_tree(&g);
+                let (parent, counts) = scalar_tree(&a, &ordered.permutation);
+                assert_eq!(t.parent, parent, "m = {m}, {}", o.name());
+                assert_eq!(t.counts, counts, "m = {m}, {}", o.name());
+                assert_eq!(t.counts.iter().sum::<usize>(), ordered.fill.nnz_l);
+            }
+        }
+    }
+
+    /// The reach pattern holds, in each column, the first column of every neighbour node
+    /// ordered before its own, and nothing else.
+    #[test]
+    fn the_reach_pattern_has_one_entry_per_earlier_neighbour() {
+        // Widths 2, 1, 3 on a path 0–1–2 ordered 2, 0, 1: columns 0..3 node 2, 3..5 node 0,
+        // 5 node 1.
+        let a = blocked(&[2, 1, 3], &[(0, 1), (1, 2)]);
+        let g = NodeGraph::of(a.as_ref()).unwrap();
+        let (parent, below) = g.tree_and_counts(&[2, 0, 1]);
+        let tree = NodeTree {
+            nodes: vec![2, 0, 1],
+            parent,
+            below,
+        };
+        let r = tree.reach_pattern(&g);
+        assert_eq!(r.col_ptr, [0, 0, 0, 0, 0, 0, 2]);
+        assert_eq!(r.row_idx, [0, 3]);
+        let t = tree.scalar_tree(&g);
+        // Node 1 (position 2) joins both: the root; nodes 2 and 0 have it as parent.
+        assert_eq!(t.parent, [1, 2, 5, 4, 5, -1]);
+        assert_eq!(t.counts, [4, 3, 2, 3, 2, 1]);
     }
 
     #[test]
