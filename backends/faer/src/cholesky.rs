@@ -57,43 +57,6 @@ pub struct FaerCholesky {
     workspace: Option<Workspace>,
     /// One right-hand side in the factor's order, kept between solves.
     work: Vec<f64>,
-    /// Predicted factors of at least this many bytes get a prefaulted buffer.
-    prefault_bytes: usize,
-    /// The first factorization's value buffer, being mapped on a thread of its own since the
-    /// ordering ([`PrefaultedValues`]).
-    prefaulted: Option<PrefaultedValues>,
-}
-
-/// A buffer for L's values whose pages a helper thread maps (writes) while the analysis
-/// finishes: the first touch of a fresh factor costs a page fault per 4 KiB (≈ 190,000 on the
-/// L cell's 775 MB), which the factorization's threads would otherwise take in its critical
-/// path. Only the predicted nnz(L), a lower bound of faer's stored values, is touched, so no
-/// page is mapped that the factor does not use.
-struct PrefaultedValues(std::thread::JoinHandle<Vec<f64>>);
-
-/// Factors of at least this many bytes get a [`PrefaultedValues`] buffer (smaller ones fault
-/// in less time than a thread takes to start and share the cores).
-const PREFAULT_BYTES: usize = 64 << 20;
-
-impl PrefaultedValues {
-    /// Starts mapping a buffer of capacity `capacity` with its first `touched` values zero.
-    fn start(touched: usize, capacity: usize) -> Self {
-        PrefaultedValues(std::thread::spawn(move || {
-            let mut values = Vec::with_capacity(capacity.max(touched));
-            values.resize(touched, 0.0);
-            values
-        }))
-    }
-
-    /// The buffer as `len` zeros, if it holds them without reallocating (else `None`, and the
-    /// factorization allocates its own).
-    fn take(self, len: usize) -> Option<Vec<f64>> {
-        let mut values = self.0.join().ok()?;
-        (values.capacity() >= len).then(|| {
-            values.resize(len, 0.0);
-            values
-        })
-    }
 }
 
 struct Analysis {
@@ -180,16 +143,7 @@ impl FaerCholesky {
             factor: None,
             workspace: None,
             work: Vec::new(),
-            prefault_bytes: PREFAULT_BYTES,
-            prefaulted: None,
         }
-    }
-
-    /// Prefaults the factor's buffer from `bytes` of predicted values on (tests).
-    #[cfg(test)]
-    pub(crate) fn with_prefault_bytes(mut self, bytes: usize) -> Self {
-        self.prefault_bytes = bytes;
-        self
     }
 
     /// Pivots of the diagonally scaled matrix below this are rejected (default 1e-12).
@@ -421,20 +375,10 @@ impl LinearSolver for FaerCholesky {
         self.factor = None;
         self.analysis = None;
         self.workspace = None;
-        self.prefaulted = None;
         let n = a.ncols();
         let (perm, name, order) = self.permutation(a)?;
         let fill = order.as_ref().map(|o| o.fill);
-        // faer stores each supernode's diagonal block square and relaxed zeros: its values
-        // exceed nnz(L) by ≈ 25 % on the generated cells, hence the capacity.
-        self.prefaulted = fill.and_then(|f| {
-            (8 * f.nnz_l >= self.prefault_bytes)
-                .then(|| PrefaultedValues::start(f.nnz_l, f.nnz_l + f.nnz_l / 2))
-        });
-        let symbolic = self.symbolic(a, &perm, order.as_ref()).inspect_err(|_| {
-            // The buffer's thread detaches and frees it when done.
-            self.prefaulted = None;
-        })?;
+        let symbolic = self.symbolic(a, &perm, order.as_ref())?;
         drop(order);
         // faer's supernodes store explicit zeros where they were relaxed; nnz(L) and the
         // flops are the structure's (from the node graph, else faer's column counts).
@@ -495,11 +439,7 @@ impl LinearSolver for FaerCholesky {
         let mut f = match self.factor.take().and_then(|f| Arc::try_unwrap(f).ok()) {
             Some(f) => f,
             None => Factor {
-                l_values: self
-                    .prefaulted
-                    .take()
-                    .and_then(|p| p.take(an.symbolic.len_val()))
-                    .unwrap_or_else(|| vec![0.0; an.symbolic.len_val()]),
+                l_values: vec![0.0; an.symbolic.len_val()],
                 scale: vec![0.0; n],
             },
         };
@@ -656,8 +596,6 @@ impl LinearSolver for FaerCholesky {
             factor: self.factor.clone(),
             workspace: None,
             work: Vec::new(),
-            prefault_bytes: self.prefault_bytes,
-            prefaulted: None,
         }))
     }
 
@@ -878,29 +816,6 @@ mod tests {
                 }
             }
         }
-    }
-
-    /// A factorization into the prefaulted buffer (every analysis given one) equals one into
-    /// a fresh buffer bit for bit, again after a refactorization; a buffer too small for
-    /// faer's values is refused, not grown.
-    #[test]
-    fn the_prefaulted_buffer_holds_the_same_factor() {
-        let a = grid(14);
-        let factor = |bytes: usize| {
-            let mut s = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::NestedDissection)
-                .with_prefault_bytes(bytes);
-            s.analyze(a.as_ref()).unwrap();
-            assert_eq!(s.prefaulted.is_some(), bytes == 0);
-            s.factorize(a.as_ref()).unwrap();
-            assert!(s.prefaulted.is_none());
-            let first = s.factor_view().values.to_vec();
-            s.factorize(a.as_ref()).unwrap();
-            assert_eq!(first, s.factor_view().values);
-            first
-        };
-        assert_eq!(factor(0), factor(usize::MAX));
-        assert_eq!(PrefaultedValues::start(4, 6).take(5), Some(vec![0.0; 5]));
-        assert_eq!(PrefaultedValues::start(4, 6).take(7), None);
     }
 
     /// nnz(L) is the factor's structure (its entries on and below the diagonal that are not
