@@ -207,7 +207,7 @@ impl FaerCholesky {
         self
     }
 
-    /// The fill-reducing permutation of `a` (checked structurally symmetric), its name and,
+    /// The fill-reducing permutation of `a` (checked here structurally symmetric), its name and,
     /// for an ordering made on the node graph (AMD, nested dissection, Auto: the one with
     /// fewer flops predicted there), the graph with the order's tree and fill — the factor's
     /// exact structure.
@@ -217,7 +217,7 @@ impl FaerCholesky {
     ) -> Result<(Permutation, String, Option<NodeOrder>), SolverError> {
         match &self.ordering {
             o @ (FillOrdering::Auto | FillOrdering::Amd | FillOrdering::NestedDissection) => {
-                let graph = NodeGraph::of_checked(a);
+                let graph = NodeGraph::of(a)?;
                 let ordered = graph.ordered(o)?;
                 let name = match o {
                     FillOrdering::Auto => format!("auto→{}", ordered.chosen.name()),
@@ -230,7 +230,10 @@ impl FaerCholesky {
                 };
                 Ok((ordered.permutation, name, Some(order)))
             }
-            o => Ok((compute_ordering(a, o)?, o.name().to_string(), None)),
+            o => {
+                a.check_structurally_symmetric()?;
+                Ok((compute_ordering(a, o)?, o.name().to_string(), None))
+            }
         }
     }
 
@@ -371,7 +374,9 @@ impl LinearSolver for FaerCholesky {
     }
 
     fn analyze(&mut self, a: CscRef<'_>) -> Result<AnalyzeInfo, SolverError> {
-        <dyn LinearSolver>::check_symmetric_matrix(a)?;
+        // The pattern's symmetry is checked with the ordering (on the nodes where it is made
+        // on the node graph).
+        <dyn LinearSolver>::check_matrix(a, None)?;
         self.factor = None;
         self.analysis = None;
         self.workspace = None;

@@ -67,16 +67,68 @@ pub struct FillEstimate {
 
 impl NodeGraph {
     /// The node graph of `a`, whose pattern must be square and symmetric (checked: AMD and
-    /// METIS hang or return nonsense on one triangle).
+    /// METIS hang or return nonsense on one triangle). The check runs on the nodes
+    /// ([`NodeGraph::groups_a_symmetric_pattern`]: one lookup per node edge, not per entry, on
+    /// a beam network); only a refused pattern goes through
+    /// [`CscRef::check_structurally_symmetric`], for the first entry without its mirror.
     pub fn of(a: CscRef<'_>) -> Result<Self, SolverError> {
-        a.check_structurally_symmetric()?;
-        Ok(Self::of_checked(a))
+        if a.nrows() != a.ncols() {
+            a.check_structurally_symmetric()?;
+        }
+        let (graph, group) = Self::with_groups(a);
+        if !graph.groups_a_symmetric_pattern(a, &group) {
+            a.check_structurally_symmetric()?;
+        }
+        Ok(graph)
+    }
+
+    /// Whether the square pattern of `a`, grouped into this graph's nodes by
+    /// [`NodeGraph::with_groups`] (consecutive columns with identical patterns; `group[j]` the
+    /// node of column j), is symmetric: exactly when (i) every node's pattern is made of whole
+    /// nodes (it holds all rows of a node or none) and (ii) the node adjacency is symmetric.
+    ///
+    /// If: take an entry (i, j), j in node g and i in node h. Column j's pattern is g's, which
+    /// holds i, so all of h by (i); then h = g, or h is g's neighbour and by (ii) g is h's,
+    /// so h's pattern holds a row of g and by (i) all of g, j among them: column i holds j.
+    /// Only if: with a symmetric pattern row i's pattern is column i's, the same for all
+    /// columns of h, so a column holds all rows of h or none (i); (ii) follows.
+    fn groups_a_symmetric_pattern(&self, a: CscRef<'_>, group: &[usize]) -> bool {
+        use rayon::prelude::*;
+        let whole_nodes = |g: usize| {
+            let rows = a.col(self.starts[g]).0;
+            let mut p = 0;
+            while p < rows.len() {
+                let h = group[rows[p]];
+                let (first, end) = (self.starts[h], self.starts[h + 1]);
+                let run = &rows[p..(p + end - first).min(rows.len())];
+                if run.len() != end - first || run[0] != first || run[run.len() - 1] != end - 1 {
+                    return false;
+                }
+                p += run.len();
+            }
+            true
+        };
+        let mirrored = |g: usize| {
+            self.neighbours(g)
+                .iter()
+                .all(|&h| self.neighbours(h).binary_search(&g).is_ok())
+        };
+        (0..self.nodes())
+            .into_par_iter()
+            .with_min_len(1024)
+            .all(|g| whole_nodes(g) && mirrored(g))
     }
 
     /// [`NodeGraph::of`] for a pattern the caller has checked with
-    /// [`CscRef::check_structurally_symmetric`], as a backend's `analyze` does (on an
-    /// asymmetric pattern the orderings may hang or return nonsense).
+    /// [`CscRef::check_structurally_symmetric`] (on an asymmetric pattern the orderings may
+    /// hang or return nonsense).
     pub fn of_checked(a: CscRef<'_>) -> Self {
+        Self::with_groups(a).0
+    }
+
+    /// The graph of `a`'s pattern as [`NodeGraph::of_checked`] makes it, and the node of each
+    /// column.
+    fn with_groups(a: CscRef<'_>) -> (Self, Vec<usize>) {
         let n = a.ncols();
         let mut starts = Vec::new();
         let mut group = vec![0usize; n];
@@ -102,7 +154,7 @@ impl NodeGraph {
             }
             xadj.push(adj.len());
         }
-        NodeGraph { starts, xadj, adj }
+        (NodeGraph { starts, xadj, adj }, group)
     }
 
     /// Number of nodes.
@@ -741,6 +793,75 @@ mod tests {
         // Node 1 (position 2) joins both: the root; nodes 2 and 0 have it as parent.
         assert_eq!(t.parent, [1, 2, 5, 4, 5, -1]);
         assert_eq!(t.counts, [4, 3, 2, 3, 2, 1]);
+    }
+
+    /// The matrix of `a` without the stored entries at `drop` (value indices).
+    fn without(a: &CscMatrix, drop: &[usize]) -> CscMatrix {
+        let a = a.as_ref();
+        let mut t = Vec::new();
+        for j in 0..a.ncols() {
+            let (rows, values) = a.col(j);
+            for (k, (&i, &v)) in rows.iter().zip(values).enumerate() {
+                if !drop.contains(&(a.col_ptr()[j] + k)) {
+                    t.push((i, j, v));
+                }
+            }
+        }
+        CscMatrix::from_triplets(a.nrows(), a.ncols(), &t).unwrap()
+    }
+
+    /// The check on the nodes accepts exactly what the scalar check accepts and refuses with
+    /// its entry: one entry dropped (asymmetric off the diagonal; symmetric on it, and the
+    /// node of that column splits), a mirrored pair dropped (symmetric, nodes split), and
+    /// one block of a pair dropped (the nodes stay whole, their adjacency is one-sided).
+    #[test]
+    fn the_node_check_agrees_with_the_scalar_check() {
+        let a = scattered(40);
+        let r = a.as_ref();
+        let symmetric = |b: CscRef<'_>| {
+            let (g, group) = NodeGraph::with_groups(b);
+            g.groups_a_symmetric_pattern(b, &group)
+        };
+        assert!(symmetric(r));
+        let position = |i: usize, j: usize| {
+            let rows = r.col(j).0;
+            r.col_ptr()[j] + rows.binary_search(&i).unwrap()
+        };
+        let mut cases: Vec<Vec<usize>> = (0..r.nnz()).step_by(5).map(|k| vec![k]).collect();
+        let (mut accepted, mut refused) = (0, 0);
+        for j in (0..r.ncols()).step_by(3) {
+            for &i in r.col(j).0.iter().filter(|&&i| i > j).take(2) {
+                cases.push(vec![position(i, j), position(j, i)]);
+            }
+        }
+        // One side of the block between the first node and its first neighbour.
+        let g = NodeGraph::of_checked(r);
+        let h = g.neighbours(0)[0];
+        let block: Vec<usize> = (g.starts[h]..g.starts[h + 1])
+            .flat_map(|i| (g.starts[0]..g.starts[1]).map(move |j| (i, j)))
+            .map(|(i, j)| position(i, j))
+            .collect();
+        cases.push(block);
+        for drop in &cases {
+            let b = without(&a, drop);
+            let scalar = b.as_ref().check_structurally_symmetric();
+            let nodes = symmetric(b.as_ref());
+            assert_eq!(nodes, scalar.is_ok(), "dropped {drop:?}");
+            assert_eq!(
+                NodeGraph::of(b.as_ref()).map(|_| ()),
+                scalar,
+                "dropped {drop:?}"
+            );
+            if nodes {
+                accepted += 1;
+            } else {
+                refused += 1;
+            }
+        }
+        assert!(
+            accepted >= 20 && refused >= 20,
+            "{accepted} accepted, {refused} refused"
+        );
     }
 
     #[test]
