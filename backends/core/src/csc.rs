@@ -5,6 +5,10 @@ use rayon::prelude::*;
 #[cfg(feature = "sprs")]
 use sprs::{CompressedStorage, CsMatView};
 
+/// Rows of a symmetric product of several columns ([`CscRef::fold_many_symmetric_par`]) go
+/// to the threads in chunks of this many.
+pub const PRODUCT_CHUNK: usize = 1024;
+
 /// A borrowed CSC matrix: `col_ptr` (len ncols + 1), `row_idx` and `values` (len nnz).
 ///
 /// Row indices are strictly increasing inside each column. Symmetric matrices store both
@@ -367,13 +371,10 @@ impl<'a> CscRef<'a> {
     }
 
     /// Y = A X for a **symmetric** A and the `k` columns of `x` (length n each, stacked), with
-    /// ‖A‖∞, in one pass over A: rows go in chunks to the threads, each column of A is read
-    /// as a row (A = Aᵀ) once for up to eight right-hand sides, its entries' products summed
-    /// in registers. Each entry of Y is the sum [`CscRef::mul_vec_symmetric_par`] forms, by
-    /// one task: the result does not depend on the threads.
+    /// ‖A‖∞, in one pass over A ([`CscRef::fold_many_symmetric_par`]). Each entry of Y is the
+    /// sum [`CscRef::mul_vec_symmetric_par`] forms, by one task: the result does not depend on
+    /// the threads.
     pub fn mul_many_symmetric_norm_par(&self, x: &[f64], k: usize, y: &mut [f64]) -> f64 {
-        const CHUNK: usize = 1024;
-        const GROUP: usize = 8;
         let n = self.ncols;
         assert!(
             x.len() == n * k && y.len() == n * k,
@@ -387,43 +388,75 @@ impl<'a> CscRef<'a> {
             return self.mul_vec_symmetric_norm_par(x, y);
         }
         // Per chunk of rows: its piece of every column of Y.
-        let mut pieces: Vec<Vec<&mut [f64]>> = (0..n.div_ceil(CHUNK))
+        let mut pieces: Vec<Vec<&mut [f64]>> = (0..n.div_ceil(PRODUCT_CHUNK))
             .map(|_| Vec::with_capacity(k))
             .collect();
         for column in y.chunks_mut(n) {
-            for (piece, rows) in pieces.iter_mut().zip(column.chunks_mut(CHUNK)) {
+            for (piece, rows) in pieces.iter_mut().zip(column.chunks_mut(PRODUCT_CHUNK)) {
                 piece.push(rows);
             }
         }
-        pieces
+        let (norm, _) = self.fold_many_symmetric_par(x, k, pieces, |columns, i, c0, sums| {
+            for (column, &s) in columns[c0..].iter_mut().zip(sums) {
+                column[i % PRODUCT_CHUNK] = s;
+            }
+        });
+        norm
+    }
+
+    /// A X for a **symmetric** A and the `k` columns of `x` (length n each, stacked), handed
+    /// to `visit` as it is formed, and ‖A‖∞, in one pass over A: the rows go in chunks of
+    /// [`PRODUCT_CHUNK`] to the threads, each column of A read as a row (A = Aᵀ) once for up
+    /// to eight right-hand sides, its entries' products summed in registers.
+    /// `visit(state, i, c0, sums)` receives the entries (i, c0), (i, c0 + 1), … of A X with
+    /// the state of row i's chunk (`states` holds one per chunk, returned in chunk order).
+    pub fn fold_many_symmetric_par<T: Send>(
+        &self,
+        x: &[f64],
+        k: usize,
+        states: Vec<T>,
+        visit: impl Fn(&mut T, usize, usize, &[f64]) + Sync,
+    ) -> (f64, Vec<T>) {
+        const GROUP: usize = 8;
+        let n = self.ncols;
+        assert!(x.len() == n * k, "X must be n × k");
+        assert_eq!(
+            states.len(),
+            n.div_ceil(PRODUCT_CHUNK),
+            "one state per chunk"
+        );
+        if k == 0 {
+            return (0.0, states);
+        }
+        let folded: Vec<(f64, T)> = states
             .into_par_iter()
             .enumerate()
-            .map(|(chunk, mut columns)| {
-                let (first, len) = (chunk * CHUNK, columns[0].len());
+            .map(|(chunk, mut state)| {
+                let rows_of_chunk = chunk * PRODUCT_CHUNK..n.min((chunk + 1) * PRODUCT_CHUNK);
                 let mut norm = 0.0f64;
                 for c0 in (0..k).step_by(GROUP) {
                     let m = GROUP.min(k - c0);
                     let xs: [&[f64]; GROUP] =
                         std::array::from_fn(|c| &x[(c0 + c.min(m - 1)) * n..][..n]);
-                    for i in 0..len {
-                        let (rows, vals) = self.col(first + i);
+                    for i in rows_of_chunk.clone() {
+                        let (rows, vals) = self.col(i);
                         let mut sums = [0.0; GROUP];
                         for (&r, &v) in rows.iter().zip(vals) {
                             for (s, xc) in sums.iter_mut().zip(&xs).take(m) {
                                 *s += v * xc[r];
                             }
                         }
-                        for (column, s) in columns[c0..c0 + m].iter_mut().zip(sums) {
-                            column[i] = s;
-                        }
+                        visit(&mut state, i, c0, &sums[..m]);
                         if c0 == 0 {
                             norm = norm.max(vals.iter().map(|v| v.abs()).sum());
                         }
                     }
                 }
-                norm
+                (norm, state)
             })
-            .reduce(|| 0.0, f64::max)
+            .collect();
+        let norm = folded.iter().fold(0.0f64, |m, (v, _)| m.max(*v));
+        (norm, folded.into_iter().map(|(_, t)| t).collect())
     }
 
     /// Copies into an owned matrix.
