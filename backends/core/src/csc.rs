@@ -7,7 +7,7 @@ use sprs::{CompressedStorage, CsMatView};
 
 /// Rows of a symmetric product of several columns ([`CscRef::fold_many_symmetric_par`]) go
 /// to the threads in chunks of this many.
-pub const PRODUCT_CHUNK: usize = 1024;
+pub(crate) const PRODUCT_CHUNK: usize = 1024;
 
 /// A borrowed CSC matrix: `col_ptr` (len ncols + 1), `row_idx` and `values` (len nnz).
 ///
@@ -406,7 +406,7 @@ impl<'a> CscRef<'a> {
 
     /// A X for a **symmetric** A and the `k` columns of `x` (length n each, stacked), handed
     /// to `visit` as it is formed, and ‖A‖∞, in one pass over A: the rows go in chunks of
-    /// [`PRODUCT_CHUNK`] to the threads, each column of A read as a row (A = Aᵀ) once for up
+    /// 1,024 to the threads, each column of A read as a row (A = Aᵀ) once for up
     /// to eight right-hand sides, its entries' products summed in registers.
     /// `visit(state, i, c0, sums)` receives the entries (i, c0), (i, c0 + 1), … of A X with
     /// the state of row i's chunk (`states` holds one per chunk, returned in chunk order).

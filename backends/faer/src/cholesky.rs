@@ -11,6 +11,7 @@ use crate::block_solve_many::{solve_many_in_place, FactorBlocks};
 use crate::block_tree::{BlockTree, FactorView};
 use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
+use crate::prefault::{PrefaultedValues, PREFAULT_BYTES};
 use crate::supernodal_llt::{self, ScaledMatrix, SupernodalPlan, TaskSizes};
 use crate::symbolic::{supernodal_of_node_tree, Raw, Symbolic};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -57,6 +58,10 @@ pub struct FaerCholesky {
     workspace: Option<Workspace>,
     /// One right-hand side in the factor's order, kept between solves.
     work: Vec<f64>,
+    /// Factors of at least this many bytes get a prefaulted first buffer.
+    prefault_bytes: usize,
+    /// The first factorization's value buffer, mapped since the analysis began.
+    prefaulted: Option<PrefaultedValues>,
 }
 
 struct Analysis {
@@ -143,7 +148,16 @@ impl FaerCholesky {
             factor: None,
             workspace: None,
             work: Vec::new(),
+            prefault_bytes: PREFAULT_BYTES,
+            prefaulted: None,
         }
+    }
+
+    /// Prefaults the first factor's buffer from `bytes` of predicted values on (tests).
+    #[cfg(test)]
+    pub(crate) fn with_prefault_bytes(mut self, bytes: usize) -> Self {
+        self.prefault_bytes = bytes;
+        self
     }
 
     /// Pivots of the diagonally scaled matrix below this are rejected (default 1e-12).
@@ -380,10 +394,20 @@ impl LinearSolver for FaerCholesky {
         self.factor = None;
         self.analysis = None;
         self.workspace = None;
+        self.prefaulted = None;
         let n = a.ncols();
+        // Every ordering's L holds A's lower triangle and the whole diagonal: at least
+        // (nnz(A) + n) / 2 values, mapped from now on (dropped, so stopped, on an error).
+        let prefault = PrefaultedValues::start((a.nnz() + n) / 2, self.prefault_bytes);
         let (perm, name, order) = self.permutation(a)?;
         let fill = order.as_ref().map(|o| o.fill);
+        if let (Some(p), Some(f)) = (&prefault, fill) {
+            p.aim(f.nnz_l);
+        }
         let symbolic = self.symbolic(a, &perm, order.as_ref())?;
+        if let Some(p) = &prefault {
+            p.aim(symbolic.len_val());
+        }
         drop(order);
         // faer's supernodes store explicit zeros where they were relaxed; nnz(L) and the
         // flops are the structure's (from the node graph, else faer's column counts).
@@ -427,6 +451,7 @@ impl LinearSolver for FaerCholesky {
             symbolic,
             kernel,
         }));
+        self.prefaulted = prefault;
         Ok(info)
     }
 
@@ -444,7 +469,10 @@ impl LinearSolver for FaerCholesky {
         let mut f = match self.factor.take().and_then(|f| Arc::try_unwrap(f).ok()) {
             Some(f) => f,
             None => Factor {
-                l_values: vec![0.0; an.symbolic.len_val()],
+                l_values: self.prefaulted.take().map_or_else(
+                    || vec![0.0; an.symbolic.len_val()],
+                    |p| p.take(an.symbolic.len_val()),
+                ),
                 scale: vec![0.0; n],
             },
         };
@@ -601,6 +629,8 @@ impl LinearSolver for FaerCholesky {
             factor: self.factor.clone(),
             workspace: None,
             work: Vec::new(),
+            prefault_bytes: self.prefault_bytes,
+            prefaulted: None,
         }))
     }
 
@@ -856,6 +886,37 @@ mod tests {
     /// A shared solver solves bit for bit as its origin (one and several right-hand sides,
     /// the two halves, sparse forward columns), from two threads at once; a factorization of
     /// other values on either side leaves the other's factor as it was.
+    /// A factorization into the prefaulted buffer (every analysis given one, the helper
+    /// stopped at once or after it mapped the whole factor) equals one into a fresh buffer
+    /// bit for bit, again after a refactorization; a failed analysis keeps no buffer.
+    #[test]
+    fn the_prefaulted_buffer_holds_the_same_factor() {
+        let a = grid(14);
+        let factor = |bytes: usize, wait: bool| {
+            let mut s = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::NestedDissection)
+                .with_prefault_bytes(bytes);
+            s.analyze(a.as_ref()).unwrap();
+            assert_eq!(s.prefaulted.is_some(), bytes == 0);
+            if wait {
+                std::thread::sleep(std::time::Duration::from_millis(30));
+            }
+            s.factorize(a.as_ref()).unwrap();
+            assert!(s.prefaulted.is_none());
+            let first = s.factor_view().values.to_vec();
+            s.factorize(a.as_ref()).unwrap();
+            assert_eq!(first, s.factor_view().values);
+            first
+        };
+        let fresh = factor(usize::MAX, false);
+        assert_eq!(factor(0, false), fresh);
+        assert_eq!(factor(0, true), fresh);
+        let mut s = FaerCholesky::default().with_prefault_bytes(0);
+        let one_triangle =
+            CscMatrix::from_triplets(2, 2, &[(0, 0, 2.0), (1, 0, 1.0), (1, 1, 2.0)]).unwrap();
+        assert!(s.analyze(one_triangle.as_ref()).is_err());
+        assert!(s.prefaulted.is_none());
+    }
+
     #[test]
     fn shared_solvers_solve_alike_and_factorize_apart() {
         let (n, a, mut origin) = grid_factor(12);

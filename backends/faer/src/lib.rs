@@ -39,6 +39,7 @@ mod dense_forward;
 mod lu;
 mod permute;
 mod pivots;
+mod prefault;
 mod prefetch;
 mod sparse_forward;
 mod supernodal_llt;

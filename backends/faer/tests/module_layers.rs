@@ -4,7 +4,7 @@
 
 /// Bottom first; a module may import the ones of lower layers only.
 const LAYERS: &[&[&str]] = &[
-    &["symbolic"],
+    &["prefault", "symbolic"],
     &[
         "block_tree",
         "column_layout",

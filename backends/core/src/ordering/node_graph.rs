@@ -68,7 +68,7 @@ pub struct FillEstimate {
 impl NodeGraph {
     /// The node graph of `a`, whose pattern must be square and symmetric (checked: AMD and
     /// METIS hang or return nonsense on one triangle). The check runs on the nodes
-    /// ([`NodeGraph::groups_a_symmetric_pattern`]: one lookup per node edge, not per entry, on
+    /// (`NodeGraph::groups_a_symmetric_pattern`: one lookup per node edge, not per entry, on
     /// a beam network); only a refused pattern goes through
     /// [`CscRef::check_structurally_symmetric`], for the first entry without its mirror.
     pub fn of(a: CscRef<'_>) -> Result<Self, SolverError> {
