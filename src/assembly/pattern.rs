@@ -154,18 +154,13 @@ impl Pattern {
     }
 
     /// A zero for every stored entry, written on all threads so that the writes map the pages,
-    /// one fault each. Zeros from the allocator alone are mapped by a fill's first `+=`: its
-    /// read maps the shared zero page and its write replaces it, two faults and a TLB
-    /// shootdown on every core per page (measured: 10 % of `homogenize` on the L cell).
+    /// one fault each ([`fibercell_solver::extend_with_zeros_par`]). Zeros from the allocator
+    /// alone are mapped by a fill's first `+=`: its read maps the shared zero page and its
+    /// write replaces it, two faults and a TLB shootdown on every core per page (measured:
+    /// 10 % of `homogenize` on the L cell).
     pub fn zero_values(&self) -> Vec<f64> {
-        let n = self.nnz();
-        let mut values = Vec::with_capacity(n);
-        values
-            .spare_capacity_mut()
-            .par_chunks_mut(1 << 15)
-            .for_each(|chunk| chunk.fill(std::mem::MaybeUninit::new(0.0)));
-        // SAFETY: the n elements of the capacity were all written just above.
-        unsafe { values.set_len(n) };
+        let mut values = Vec::new();
+        fibercell_solver::extend_with_zeros_par(&mut values, self.nnz());
         values
     }
     /// Column pointers.

@@ -371,7 +371,7 @@ impl<'a> CscRef<'a> {
     }
 
     /// Y = A X for a **symmetric** A and the `k` columns of `x` (length n each, stacked), with
-    /// ‖A‖∞, in one pass over A ([`CscRef::fold_many_symmetric_par`]). Each entry of Y is the
+    /// ‖A‖∞, in one pass over A (`CscRef::fold_many_symmetric_par`). Each entry of Y is the
     /// sum [`CscRef::mul_vec_symmetric_par`] forms, by one task: the result does not depend on
     /// the threads.
     pub fn mul_many_symmetric_norm_par(&self, x: &[f64], k: usize, y: &mut [f64]) -> f64 {
@@ -410,7 +410,7 @@ impl<'a> CscRef<'a> {
     /// to eight right-hand sides, its entries' products summed in registers.
     /// `visit(state, i, c0, sums)` receives the entries (i, c0), (i, c0 + 1), … of A X with
     /// the state of row i's chunk (`states` holds one per chunk, returned in chunk order).
-    pub fn fold_many_symmetric_par<T: Send>(
+    pub(crate) fn fold_many_symmetric_par<T: Send>(
         &self,
         x: &[f64],
         k: usize,

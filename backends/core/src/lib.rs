@@ -30,6 +30,7 @@ mod matrix_market;
 mod ordering;
 mod residual;
 mod solver;
+mod zeros;
 
 pub use condition::{inverse_norm1_estimate, norm1, SolveWith};
 pub use csc::{CscMatrix, CscRef, PatternFingerprint};
@@ -47,3 +48,4 @@ pub use residual::{
     relative_residual, solve_checked, vector_norm_inf, SolveReport,
 };
 pub use solver::{AnalyzeInfo, Capabilities, LinearSolver, SolveInfo};
+pub use zeros::extend_with_zeros_par;

@@ -883,9 +883,6 @@ mod tests {
         );
     }
 
-    /// A shared solver solves bit for bit as its origin (one and several right-hand sides,
-    /// the two halves, sparse forward columns), from two threads at once; a factorization of
-    /// other values on either side leaves the other's factor as it was.
     /// A factorization into the prefaulted buffer (every analysis given one, the helper
     /// stopped at once or after it mapped the whole factor) equals one into a fresh buffer
     /// bit for bit, again after a refactorization; a failed analysis keeps no buffer.
@@ -917,6 +914,9 @@ mod tests {
         assert!(s.prefaulted.is_none());
     }
 
+    /// A shared solver solves bit for bit as its origin (one and several right-hand sides,
+    /// the two halves, sparse forward columns), from two threads at once; a factorization of
+    /// other values on either side leaves the other's factor as it was.
     #[test]
     fn shared_solvers_solve_alike_and_factorize_apart() {
         let (n, a, mut origin) = grid_factor(12);

@@ -13,8 +13,7 @@
 //! follows holds the mapped buffer (the factor's size) until its solver analyzes again or is
 //! dropped.
 
-use rayon::prelude::*;
-use std::mem::MaybeUninit;
+use fibercell_solver::extend_with_zeros_par;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -84,14 +83,7 @@ impl PrefaultedValues {
             .and_then(|h| h.join().ok())
             .unwrap_or_default();
         values.truncate(len);
-        let done = values.len();
-        values.reserve_exact(len - done);
-        values.spare_capacity_mut()[..len - done]
-            .par_chunks_mut(1 << 15)
-            .for_each(|chunk| chunk.fill(MaybeUninit::new(0.0)));
-        // SAFETY: the first `done` values were initialized by the helper and the next
-        // `len - done` of the capacity just above.
-        unsafe { values.set_len(len) };
+        extend_with_zeros_par(&mut values, len);
         values
     }
 
