@@ -11,7 +11,7 @@ use crate::model::Model;
 use crate::solve::DriverCouplings;
 use crate::solve::{check_backward_error, SolveOptions};
 use crate::Error;
-use fibercell_solver::{solve_checked, CscRef, LinearSolver, SolverError};
+use fibercell_solver::{solve_checked, solve_checked_into, CscRef, LinearSolver, SolverError};
 use nalgebra::DMatrix;
 use serde::Serialize;
 
@@ -132,7 +132,7 @@ fn factor_cell<T: Send>(
     model: &Model,
     options: &SolveOptions,
     timings: &mut HomogenizeTimings,
-    beside: impl FnOnce(&PeriodicSystem) -> T + Send,
+    beside: impl FnOnce(&PeriodicSystem, &PeriodicValues) -> T + Send,
 ) -> Result<(PeriodicSystem, PeriodicValues, Box<dyn LinearSolver>, T), Error> {
     let mut clock = std::time::Instant::now();
     let sys = PeriodicSystem::new(model)?;
@@ -144,7 +144,7 @@ fn factor_cell<T: Send>(
         .solver_config(sys.discretization.node_block_starts())
         .build()?;
     let (factored, extra) = std::thread::scope(|scope| {
-        let side = scope.spawn(|| beside(&sys));
+        let side = scope.spawn(|| beside(&sys, &vals));
         let mut factor = || -> Result<(), Error> {
             solver.analyze(a).map_err(|e| sys.locate(model, e))?;
             timings.analysis = lap_seconds(&mut clock);
@@ -242,7 +242,7 @@ pub fn cell_problem(model: &Model) -> Result<LinearSystem, Error> {
 /// [`super::elasto_plastic_curve`] splits its resultants with).
 pub fn elastic_abd(model: &Model, options: &SolveOptions) -> Result<[[f64; 6]; 6], Error> {
     let (sys, vals, mut solver, ()) =
-        factor_cell(model, options, &mut HomogenizeTimings::default(), |_| ())?;
+        factor_cell(model, options, &mut HomogenizeTimings::default(), |_, _| ())?;
     let a = sys.pattern.matrix(&vals.values)?;
     let area = sys.periodicity.geometry.area();
     abd_on_factor(&vals.couplings, area, solver.as_mut(), a, options, &|e| {
@@ -269,12 +269,9 @@ pub(super) fn abd_on_factor(
     Ok(abd_of(couplings, &x, n, area))
 }
 
-/// The Θ load of a cell on its unknowns: the pressure load moved onto the generalized DOFs
-/// (Tᵀ f, periodic images included), the part on the driver, and the virial Σ M(x)ᵀ f over the
-/// loaded points (images at their shifted positions).
+/// The Θ load of a cell beside its right-hand side on the unknowns: the part on the driver,
+/// and the virial Σ M(x)ᵀ f over the loaded points (images at their shifted positions).
 struct ThetaLoad {
-    /// The right-hand side on the free unknowns.
-    column: Vec<f64>,
     /// The load on the driver's six DOFs.
     driver_load: [f64; 6],
     /// Σ M(x)ᵀ f.
@@ -287,14 +284,14 @@ struct ThetaLoad {
     seconds: f64,
 }
 
-/// The unit-pressure load of `model` on the unknowns of `sys`.
-fn theta_load(model: &Model, sys: &PeriodicSystem) -> ThetaLoad {
+/// The unit-pressure load of `model` moved onto the generalized DOFs of `sys` (Tᵀ f, periodic
+/// images included) and added into `column` (one value per free unknown).
+fn theta_load(model: &Model, sys: &PeriodicSystem, column: &mut [f64]) -> ThetaLoad {
     let start = std::time::Instant::now();
     let g = sys.periodicity.geometry;
     let disc = &sys.discretization;
     let driver = disc.driver().unwrap_or(usize::MAX);
     let load = pressure_load(model, &g, 1.0, default_pixel(model));
-    let mut column = vec![0.0; sys.n_free()];
     let (mut driver_load, mut virial) = ([0.0; 6], [0.0; 6]);
     for (e, shift, f) in &load.elements {
         let nodes = model.elements()[*e].nodes;
@@ -322,7 +319,6 @@ fn theta_load(model: &Model, sys: &PeriodicSystem) -> ThetaLoad {
         }
     }
     ThetaLoad {
-        column,
         driver_load,
         virial,
         coverage: load.coverage,
@@ -331,13 +327,41 @@ fn theta_load(model: &Model, sys: &PeriodicSystem) -> ThetaLoad {
     }
 }
 
+/// What the thread beside the analysis prepares for the seven solves of
+/// [`homogenize_elastic`].
+struct CellLoads {
+    /// The right-hand sides: the six cell problems −K_fE e_k, then Θ, column after column.
+    rhs: Vec<f64>,
+    /// A buffer of the same length for the solutions, its pages mapped (by writing zeros) so
+    /// that the solve does not wait on their first touch.
+    solutions: Vec<f64>,
+    /// The pressure load's driver part, virial and sampling.
+    theta: ThetaLoad,
+}
+
+/// The [`CellLoads`] of `model` on the system `sys` with the values `vals`.
+fn cell_loads(model: &Model, sys: &PeriodicSystem, vals: &PeriodicValues) -> CellLoads {
+    let n = sys.n_free();
+    let mut rhs = cell_rhs(&vals.couplings, n, 1);
+    let theta = theta_load(model, sys, &mut rhs[6 * n..]);
+    let mut solutions = Vec::with_capacity(rhs.len());
+    solutions.resize(rhs.len(), 0.0);
+    CellLoads {
+        rhs,
+        solutions,
+        theta,
+    }
+}
+
 /// Solves the six unit cell problems of `model` (which needs a `[cell]`) and returns ABD and
 /// the derived constants.
 pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homogenized, Error> {
     let start = std::time::Instant::now();
     let mut timings = HomogenizeTimings::default();
-    let (sys, vals, mut solver, load) =
-        factor_cell(model, options, &mut timings, |sys| theta_load(model, sys))?;
+    let (sys, vals, mut solver, loads) = factor_cell(model, options, &mut timings, |sys, vals| {
+        cell_loads(model, sys, vals)
+    })?;
+    let load = loads.theta;
     timings.pressure_load = load.seconds;
     let mut clock = std::time::Instant::now();
     let mut lap = || lap_seconds(&mut clock);
@@ -346,9 +370,8 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
     let locate = |e: SolverError| sys.locate(model, e);
     let g = sys.periodicity.geometry;
     let area = g.area();
-    let mut rhs = cell_rhs(&vals.couplings, n, 1);
-    rhs[6 * n..].copy_from_slice(&load.column);
-    let (x, report) = solve_checked(solver.as_mut(), a, &rhs, 7).map_err(locate)?;
+    let (x, report) =
+        solve_checked_into(solver.as_mut(), a, &loads.rhs, loads.solutions, 7).map_err(locate)?;
     check_backward_error(options, report.backward_error, "cell problems")?;
     timings.solve = lap();
     let theta = &x[6 * n..7 * n];

@@ -45,7 +45,7 @@ pub use ordering::{
 };
 pub use residual::{
     backward_error, backward_from_product, norm_inf, norm_inf_symmetric_par, relative_from_product,
-    relative_residual, solve_checked, vector_norm_inf, SolveReport,
+    relative_residual, solve_checked, solve_checked_into, vector_norm_inf, SolveReport,
 };
 pub use solver::{AnalyzeInfo, Capabilities, LinearSolver, SolveInfo};
 pub use zeros::extend_with_zeros_par;

@@ -107,9 +107,25 @@ pub fn solve_checked(
     b: &[f64],
     nrhs: usize,
 ) -> Result<(Vec<f64>, SolveReport), SolverError> {
+    solve_checked_into(solver, a, b, Vec::new(), nrhs)
+}
+
+/// [`solve_checked`] with the solution written into `buffer` (its contents are replaced; it
+/// grows if it is shorter than `b`). A buffer whose pages are already mapped — written on a
+/// thread that would otherwise idle, say — keeps the first touch of n·nrhs new values off the
+/// solve.
+pub fn solve_checked_into(
+    solver: &mut dyn LinearSolver,
+    a: CscRef<'_>,
+    b: &[f64],
+    buffer: Vec<f64>,
+    nrhs: usize,
+) -> Result<(Vec<f64>, SolveReport), SolverError> {
     let n = a.ncols();
     <dyn LinearSolver>::check_rhs(n, b, nrhs)?;
-    let mut x = b.to_vec();
+    let mut x = buffer;
+    x.clear();
+    x.extend_from_slice(b);
     let info = solver.solve_in_place(&mut x, nrhs)?;
     if let Some(i) = x.iter().position(|v| !v.is_finite()) {
         return Err(SolverError::NonFinite {

@@ -853,6 +853,37 @@ mod tests {
         }
     }
 
+    /// `solve_checked_into` gives `solve_checked`'s solutions and report, bit for bit, in a
+    /// given buffer whatever it held and however long it was (shorter, equal, longer than the
+    /// right-hand sides), and it still refuses a right-hand side of the wrong length.
+    #[test]
+    fn a_given_solution_buffer_changes_nothing_but_where_the_solution_lives() {
+        use fibercell_solver::{solve_checked, solve_checked_into};
+        let a = blocked_network(300);
+        let n = a.as_ref().ncols();
+        let mut s = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::Auto);
+        s.analyze(a.as_ref()).unwrap();
+        s.factorize(a.as_ref()).unwrap();
+        for k in [1, 7] {
+            let b: Vec<f64> = (0..n * k).map(|i| ((i * 29) % 97) as f64 - 48.0).collect();
+            let (want, report) = solve_checked(&mut s, a.as_ref(), &b, k).unwrap();
+            assert!(report.backward_error < 1e-14, "{k}: {report:?}");
+            for len in [0, n * k, 3 * n * k + 5] {
+                let buffer = vec![f64::NAN; len];
+                let (got, r) = solve_checked_into(&mut s, a.as_ref(), &b, buffer, k).unwrap();
+                assert_eq!(got.len(), n * k);
+                assert!(got
+                    .iter()
+                    .zip(&want)
+                    .all(|(p, q)| p.to_bits() == q.to_bits()));
+                assert_eq!(r, report, "{k} columns, buffer of {len}");
+            }
+            let short = &b[..n * k - 1];
+            let e = solve_checked_into(&mut s, a.as_ref(), short, Vec::new(), k);
+            assert!(matches!(e, Err(SolverError::DimensionMismatch(_))), "{e:?}");
+        }
+    }
+
     /// nnz(L) is the factor's structure (its entries on and below the diagonal that are not
     /// exactly zero: a relaxed supernode's explicit zeros receive no update and stay 0.0), the
     /// stored bytes its values with those zeros, as CHOLMOD counts `lnz` and `xsize`.
