@@ -63,6 +63,10 @@ pub struct BackendBench {
     pub solve: f64,
     /// Entries of L.
     pub nnz_l: Option<usize>,
+    /// Bytes the factor's values take as stored (faer's supernodes keep square diagonal
+    /// blocks and the zeros of relaxed supernodes, so more than 8 · nnz(L)).
+    #[serde(default)]
+    pub factor_bytes: Option<usize>,
     /// Flops of one factorization, as the backend counts them.
     pub flops: Option<f64>,
     /// Factorization GFLOP/s.
@@ -414,6 +418,7 @@ fn bench_backend(
         factorize: if direct { factorize } else { 0.0 },
         solve,
         nnz_l: info.nnz_factor,
+        factor_bytes: info.factor_bytes,
         flops: info.flops,
         gflops,
         fraction_of_dgemm: gflops.map(|g| g / machine.dgemm_gflops_all),
@@ -724,6 +729,10 @@ pub struct MemoryBench {
     pub values: usize,
     /// The values of faer's Cholesky factor with the default ordering, 8 · nnz(L).
     pub factor: usize,
+    /// The same factor's values as stored ([`BackendBench::factor_bytes`]); absent in results
+    /// written before it was reported.
+    #[serde(default)]
+    pub factor_stored: Option<usize>,
 }
 
 /// Runs every stage on the preset `cell`.
@@ -823,7 +832,9 @@ pub fn bench_cell(
     });
     let mild_curve = curves[1].take().transpose()?;
     let curve = curves[0].take().transpose()?;
-    let factor_bytes = 8 * backend_results.first().and_then(|b| b.nnz_l).unwrap_or(0);
+    let default_backend = backend_results.first();
+    let factor_bytes = 8 * default_backend.and_then(|b| b.nnz_l).unwrap_or(0);
+    let factor_stored = default_backend.and_then(|b| b.factor_bytes);
     Ok(CellBench {
         cell: cell.to_string(),
         fibers: generated.report.deposited,
@@ -856,6 +867,7 @@ pub fn bench_cell(
             pattern: sys.pattern.memory_bytes(),
             values: values.values.capacity() * size_of::<f64>(),
             factor: factor_bytes,
+            factor_stored,
         }),
     })
 }

@@ -211,11 +211,22 @@ pub fn markdown(r: &BenchReport) -> String {
         );
     }
     if r.cells.iter().any(|c| c.memory.is_some()) {
-        row("memory: pattern / values of K / faer's factor", &|c| {
-            c.memory.as_ref().map_or("–".into(), |m| {
-                format!("{} / {} / {}", mb(m.pattern), mb(m.values), mb(m.factor))
-            })
-        });
+        row(
+            "memory: pattern / values of K / faer's factor, 8·nnz(L) (stored)",
+            &|c| {
+                c.memory.as_ref().map_or("–".into(), |m| {
+                    let stored = m
+                        .factor_stored
+                        .map_or(String::new(), |b| format!(" ({})", mb(b)));
+                    format!(
+                        "{} / {} / {}{stored}",
+                        mb(m.pattern),
+                        mb(m.values),
+                        mb(m.factor)
+                    )
+                })
+            },
+        );
     }
     row("peak memory", &|c| {
         opt(c.peak_memory.map(|b| format!("{:.2} GB", b as f64 / 1e9)))

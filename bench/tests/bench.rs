@@ -82,12 +82,18 @@ fn the_small_cell_runs_every_stage() {
     // Memory of the large structures: K's values are nnz(K) doubles, its pattern at least a
     // row index (usize) per entry and an element's slot map (u32: a start per column and an
     // offset per column node and row, 12 + 24 per element);
-    // the factor's values 8 · nnz(L); the curve's outputs at least a contact record per
+    // the factor's values 8 · nnz(L), and as stored at least that (faer's supernodes hold
+    // L's entries plus square diagonal blocks and relaxed zeros); the curve's outputs at least a contact record per
     // contact and increment and six doubles per node and increment.
     let m = c.memory.as_ref().expect("memory measured");
     assert_eq!(m.values, 8 * c.nnz_k);
     assert!(m.pattern >= 8 * c.nnz_k + 4 * 36 * c.elements, "{m:?}");
     assert_eq!(m.factor, 8 * c.backends[0].nnz_l.unwrap());
+    assert_eq!(m.factor_stored, c.backends[0].factor_bytes);
+    assert!(
+        m.factor_stored.expect("stored bytes reported") >= m.factor,
+        "{m:?}"
+    );
     let record = size_of::<fibercell::solve::ContactRecord>();
     let per_increment = c.contacts * record + c.dofs / 6 * 48;
     let outputs = curve.output_bytes.expect("curve outputs measured");
@@ -96,7 +102,7 @@ fn the_small_cell_runs_every_stage() {
     assert!(curve.low_rank_bytes.is_some() && mild.low_rank_bytes.is_some());
     let text = markdown(&r);
     assert!(
-        text.contains("| memory: pattern / values of K / faer's factor |"),
+        text.contains("| memory: pattern / values of K / faer's factor, 8·nnz(L) (stored) |"),
         "{text}"
     );
     assert!(
