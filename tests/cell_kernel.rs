@@ -216,7 +216,10 @@ fn the_cell_is_shared_across_threads() {
 }
 
 /// All stuck, the tangent is the elastic ABD of the six cell problems (the same matrix), to
-/// 1e-9 of its largest entry.
+/// 1e-8 of its largest entry: the cell's κ₁ is ≈ 1.1·10¹¹ (`fibercell check`), and the
+/// elastic ABD alone moves by 1·10⁻⁹ of its largest entry between two fill-reducing orderings
+/// (A11 190.3907009 with chains eliminated before METIS, 190.3907011 with the fill rule), so
+/// two computations of it agree to no better than that.
 #[test]
 fn the_stick_tangent_is_the_elastic_abd() {
     let cell = cell_with_tangent();
@@ -228,7 +231,7 @@ fn the_stick_tangent_is_the_elastic_abd() {
     let scale = abd.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     for (j, (tr, ar)) in t.iter().zip(&abd).enumerate() {
         for (k, (tv, av)) in tr.iter().zip(ar).enumerate() {
-            assert!((tv - av).abs() <= 1e-9 * scale, "[{j}][{k}] {tv} vs {av}");
+            assert!((tv - av).abs() <= 1e-8 * scale, "[{j}][{k}] {tv} vs {av}");
         }
     }
 }

@@ -15,7 +15,8 @@ pub enum FillOrdering {
     /// Approximate minimum degree (faer's) on the [`NodeGraph`].
     Amd,
     /// Nested dissection through METIS `METIS_NodeND` (the better of two separators at each
-    /// level) on the [`NodeGraph`], its nodes of degree ≤ 2 eliminated first.
+    /// level) on the [`NodeGraph`], after the nodes whose elimination removes more edges than
+    /// it adds (a fiber's free ends and chains among them).
     NestedDissection,
     /// A caller's permutation: `perm[new] = old`.
     Given(Vec<usize>),
@@ -115,6 +116,7 @@ pub fn compute_ordering(
 mod metis;
 mod node_graph;
 mod node_tree;
+mod pre_elimination;
 pub use node_graph::{FillEstimate, NodeGraph, OrderedNodes};
 pub use node_tree::{NodeTree, ReachPattern, ScalarTree};
 

@@ -10,6 +10,8 @@
 //! factorization.
 
 use super::node_tree::NodeTree;
+#[cfg(feature = "metis")]
+use super::pre_elimination::pre_eliminated;
 use super::{FillOrdering, Permutation};
 use crate::{CscRef, SolverError};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -26,15 +28,6 @@ pub struct NodeGraph {
     /// Adjacency (other nodes, ascending, no self loop) in CSR form.
     xadj: Vec<usize>,
     adj: Vec<usize>,
-}
-
-/// [`NodeGraph::without_chains`]: the nodes eliminated first in their order, the others
-/// ascending, and the graph of the others (node k of it is `kept[k]`, with its weight).
-#[cfg_attr(not(feature = "metis"), allow(dead_code))]
-struct ChainReduction {
-    eliminated: Vec<usize>,
-    kept: Vec<usize>,
-    graph: NodeGraph,
 }
 
 /// A node order (`nodes[new] = old node`), its elimination tree and unknowns below each node's
@@ -277,86 +270,20 @@ impl NodeGraph {
     }
 
     /// Nested dissection by METIS on the node graph, weighted by node size, after the nodes
-    /// of degree ≤ 2 ([`NodeGraph::without_chains`]): METIS orders the rest.
+    /// whose elimination removes more edges than it adds ([`pre_eliminated`]): METIS orders
+    /// the rest.
     #[cfg(feature = "metis")]
     fn nested_dissection(&self) -> Result<Vec<usize>, SolverError> {
-        let chains = self.without_chains();
-        let rest = super::metis::node_nested_dissection(&chains.graph)?;
-        let mut order = chains.eliminated;
-        order.extend(rest.iter().map(|&k| chains.kept[k]));
+        let first = pre_eliminated(self);
+        let rest = super::metis::node_nested_dissection(&first.graph)?;
+        let mut order = first.eliminated;
+        order.extend(rest.iter().map(|&k| first.kept[k]));
         Ok(order)
     }
 
-    /// The nodes of degree ≤ 2 eliminated first, as long as there are any (a fiber's free ends
-    /// and its nodes between two contacts, then what they leave of degree ≤ 2), and the graph
-    /// of the others with the edges those eliminations add (the neighbours of a node of degree
-    /// 2 become adjacent). Eliminating such a node costs its column and adds at most that edge,
-    /// so ordering them first costs little a separator could gain: on the L non-woven 48,261
-    /// of 155,781 nodes go, METIS orders the rest in 25 % less time, and the factor grows by
-    /// 0.16 % (nnz(L) 7.851·10⁷ against 7.839·10⁷, flops 5.37 against 5.28·10¹⁰).
-    #[cfg_attr(not(feature = "metis"), allow(dead_code))]
-    fn without_chains(&self) -> ChainReduction {
-        let m = self.nodes();
-        let mut adj: Vec<Vec<usize>> = (0..m).map(|g| self.neighbours(g).to_vec()).collect();
-        let mut alive = vec![true; m];
-        let mut eliminated = Vec::new();
-        // Nodes of degree ≤ 1 before those of degree 2: a free end goes before the node next
-        // to it, which then has degree 1, so a tail is eliminated from its end without fill.
-        let mut ends: Vec<usize> = (0..m).rev().filter(|&g| adj[g].len() <= 1).collect();
-        let mut links: Vec<usize> = (0..m).rev().filter(|&g| adj[g].len() == 2).collect();
-        while let Some(v) = ends.pop().or_else(|| links.pop()) {
-            if !alive[v] || adj[v].len() > 2 {
-                continue;
-            }
-            alive[v] = false;
-            eliminated.push(v);
-            let around = std::mem::take(&mut adj[v]);
-            for &u in &around {
-                // Present: the adjacency of a symmetric pattern is symmetric.
-                if let Some(k) = adj[u].iter().position(|&x| x == v) {
-                    adj[u].swap_remove(k);
-                }
-            }
-            if let [a, b] = around[..] {
-                if !adj[a].contains(&b) {
-                    adj[a].push(b);
-                    adj[b].push(a);
-                }
-            }
-            for &u in &around {
-                match adj[u].len() {
-                    0 | 1 => ends.push(u),
-                    2 => links.push(u),
-                    _ => {}
-                }
-            }
-        }
-        let kept: Vec<usize> = (0..m).filter(|&g| alive[g]).collect();
-        let mut index = vec![usize::MAX; m];
-        for (k, &g) in kept.iter().enumerate() {
-            index[g] = k;
-        }
-        let mut starts = Vec::with_capacity(kept.len() + 1);
-        let mut xadj = Vec::with_capacity(kept.len() + 1);
-        let mut edges = Vec::new();
-        starts.push(0);
-        xadj.push(0);
-        for &g in &kept {
-            starts.push(starts.last().copied().unwrap_or(0) + self.weight(g));
-            let first = edges.len();
-            edges.extend(adj[g].iter().map(|&h| index[h]));
-            edges[first..].sort_unstable();
-            xadj.push(edges.len());
-        }
-        ChainReduction {
-            eliminated,
-            kept,
-            graph: NodeGraph {
-                starts,
-                xadj,
-                adj: edges,
-            },
-        }
+    /// A graph from its parts: node starts (n at the end) and sorted adjacency in CSR form.
+    pub(super) fn from_parts(starts: Vec<usize>, xadj: Vec<usize>, adj: Vec<usize>) -> Self {
+        NodeGraph { starts, xadj, adj }
     }
 
     /// Without the `metis` feature there is no nested dissection.
@@ -646,38 +573,13 @@ mod tests {
         let edges: Vec<(usize, usize)> = (1..m).map(|j| (j - 1, j)).collect();
         let a = blocked(&vec![w; m], &edges);
         let g = NodeGraph::of(a.as_ref()).unwrap();
-        let chains = g.without_chains();
-        assert_eq!(chains.eliminated, (0..m).collect::<Vec<_>>());
-        assert_eq!(chains.graph.nodes(), 0);
+        let first = super::super::pre_elimination::pre_eliminated(&g);
+        assert_eq!(first.eliminated, (0..m).collect::<Vec<_>>());
+        assert_eq!(first.graph.nodes(), 0);
         let expected = m * w * (w + 1) / 2 + (m - 1) * w * w;
-        assert_eq!(g.fill(&chains.eliminated).nnz_l, expected);
-        let p = g.expand(&chains.eliminated).unwrap();
+        assert_eq!(g.fill(&first.eliminated).nnz_l, expected);
+        let p = g.expand(&first.eliminated).unwrap();
         assert_eq!(scalar_fill(&a, &p).nnz_l, expected);
-    }
-
-    /// A 3 × 3 grid of nodes with a tail of three on its centre: the corners (degree 2) and the
-    /// tail go; the four mid-side nodes and the centre stay, each corner's two neighbours now
-    /// adjacent — a ring of four around the centre, 8 edges.
-    #[test]
-    fn corners_and_tails_go_and_their_neighbours_become_adjacent() {
-        // 0 1 2 / 3 4 5 / 6 7 8, the tail 9–10–11 on the centre 4.
-        let mut edges = vec![(0, 1), (1, 2), (3, 4), (4, 5), (6, 7), (7, 8)];
-        edges.extend([(0, 3), (3, 6), (1, 4), (4, 7), (2, 5), (5, 8)]);
-        edges.extend([(4, 9), (9, 10), (10, 11)]);
-        let a = blocked(&[6; 12], &edges);
-        let g = NodeGraph::of(a.as_ref()).unwrap();
-        let chains = g.without_chains();
-        let mut gone = chains.eliminated.clone();
-        gone.sort_unstable();
-        assert_eq!(gone, [0, 2, 6, 8, 9, 10, 11]);
-        // The tail from its free end (no fill), before the corners.
-        assert_eq!(chains.eliminated[..3], [11, 10, 9]);
-        assert_eq!(chains.kept, [1, 3, 4, 5, 7]);
-        assert_eq!(chains.graph.edges(), 16);
-        // Kept node 0 is node 1: adjacent to 3, the centre 4 and 5 (kept 1, 2, 3).
-        assert_eq!(chains.graph.neighbours(0), [1, 2, 3]);
-        assert_eq!(chains.graph.neighbours(2), [0, 1, 3, 4]);
-        assert!((0..5).all(|k| chains.graph.weight(k) == 6));
     }
 
     /// Auto is the candidate with fewer predicted flops, its fill the prediction.
