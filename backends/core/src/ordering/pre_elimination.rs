@@ -22,7 +22,8 @@ use super::NodeGraph;
 use std::collections::HashSet;
 
 /// Degree above which a node is not tested (the test looks up its d(d − 1)/2 neighbour
-/// pairs). The rule itself stops below: on L caps 8 and 16 keep the same nodes.
+/// pairs). The rule itself seldom passes near it: in a first version of this code, caps 8
+/// and 16 kept the same 55,684 of L's nodes (this one keeps 55,805 at cap 8).
 const LARGEST_DEGREE_TESTED: usize = 8;
 
 /// Adjacency lists up to this length are scanned (each holds the node's own and fill edges,
