@@ -17,6 +17,10 @@ use crate::{CscRef, SolverError};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::amd;
 use faer::sparse::SymbolicSparseColMatRef;
+use rayon::prelude::*;
+
+/// Nodes whose adjacency lists one task of [`NodeGraph::with_groups`] makes.
+const NODES_PER_TASK: usize = 4096;
 
 /// A structurally symmetric matrix's graph on its supervariables. Blocks between two
 /// supervariables are full or empty: if column j of group g holds row r of group h, every
@@ -86,7 +90,6 @@ impl NodeGraph {
     /// Only if: with a symmetric pattern row i's pattern is column i's, the same for all
     /// columns of h, so a column holds all rows of h or none (i); (ii) follows.
     fn groups_a_symmetric_pattern(&self, a: CscRef<'_>, group: &[usize]) -> bool {
-        use rayon::prelude::*;
         let whole_nodes = |g: usize| {
             let rows = a.col(self.starts[g]).0;
             let mut p = 0;
@@ -120,32 +123,51 @@ impl NodeGraph {
     }
 
     /// The graph of `a`'s pattern as [`NodeGraph::of_checked`] makes it, and the node of each
-    /// column.
+    /// column. The columns' comparisons and the nodes' lists are made on the threads.
     fn with_groups(a: CscRef<'_>) -> (Self, Vec<usize>) {
         let n = a.ncols();
+        let opens: Vec<bool> = (0..n)
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|j| j == 0 || a.col(j).0 != a.col(j - 1).0)
+            .collect();
         let mut starts = Vec::new();
         let mut group = vec![0usize; n];
         for (j, g) in group.iter_mut().enumerate() {
-            if j == 0 || a.col(j).0 != a.col(j - 1).0 {
+            if opens[j] {
                 starts.push(j);
             }
             *g = starts.len() - 1;
         }
         let m = starts.len();
         starts.push(n);
-        let mut xadj = Vec::with_capacity(m + 1);
-        let mut adj = Vec::with_capacity(a.nnz() / 16 + 1);
-        xadj.push(0);
-        for (g, &first) in starts[..m].iter().enumerate() {
-            let mut last = usize::MAX;
-            for &r in a.col(first).0 {
-                let h = group[r];
-                if h != g && h != last {
-                    adj.push(h);
-                    last = h;
+        // Node g's neighbours: the nodes of its first column's rows (ascending), but g.
+        let lists: Vec<(Vec<usize>, Vec<usize>)> = starts[..m]
+            .par_chunks(NODES_PER_TASK)
+            .enumerate()
+            .map(|(c, firsts)| {
+                let (mut ends, mut adj) = (Vec::with_capacity(firsts.len()), Vec::new());
+                for (g, &first) in (c * NODES_PER_TASK..).zip(firsts) {
+                    let mut last = usize::MAX;
+                    for &r in a.col(first).0 {
+                        let h = group[r];
+                        if h != g && h != last {
+                            adj.push(h);
+                            last = h;
+                        }
+                    }
+                    ends.push(adj.len());
                 }
-            }
-            xadj.push(adj.len());
+                (ends, adj)
+            })
+            .collect();
+        let mut xadj = Vec::with_capacity(m + 1);
+        let mut adj = Vec::with_capacity(lists.iter().map(|l| l.1.len()).sum());
+        xadj.push(0);
+        for (ends, part) in lists {
+            let offset = adj.len();
+            xadj.extend(ends.iter().map(|&e| offset + e));
+            adj.extend(part);
         }
         (NodeGraph { starts, xadj, adj }, group)
     }
@@ -542,6 +564,30 @@ mod tests {
         );
         assert_eq!(g.neighbours(1), [0, 2]);
         assert_eq!(g.edges(), 6);
+    }
+
+    /// Across several tasks of [`NodeGraph::with_groups`] (a ring with chords, widths 1–3):
+    /// every node's weight, and its list the sorted distinct ends of its edges.
+    #[test]
+    fn nodes_and_lists_across_tasks_are_the_blocks_and_edges() {
+        let m = 3 * NODES_PER_TASK + 17;
+        let widths: Vec<usize> = (0..m).map(|g| 1 + g % 3).collect();
+        let mut edges: Vec<(usize, usize)> = (0..m).map(|g| (g, (g + 1) % m)).collect();
+        edges.extend((0..m).step_by(5).map(|g| (g, (g * 7919 + 11) % m)));
+        edges.retain(|&(g, h)| g != h);
+        let mut want = vec![Vec::new(); m];
+        for &(g, h) in &edges {
+            want[g].push(h);
+            want[h].push(g);
+        }
+        let g = NodeGraph::of(blocked(&widths, &edges).as_ref()).unwrap();
+        assert_eq!(g.nodes(), m);
+        for (k, mut list) in want.into_iter().enumerate() {
+            list.sort_unstable();
+            list.dedup();
+            assert_eq!(g.weight(k), widths[k], "node {k}");
+            assert_eq!(g.neighbours(k), list, "node {k}");
+        }
     }
 
     /// The fill predicted on the node graph is faer's scalar column count exactly, for node

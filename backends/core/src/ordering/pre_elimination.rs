@@ -13,7 +13,7 @@
 //! seeds 1–3, degree ≤ 2 only against this rule: L seed 1 nnz(L) 7.89 → 7.59·10⁷ and flops
 //! 5.52 → 4.98·10¹⁰ (METIS orders 107,520 → 55,805 nodes), L seed 2 7.68 → 7.49·10⁷ and
 //! 4.87 → 4.77·10¹⁰, M 1.141 → 1.127·10⁷ and 4.02 → 4.07·10⁹. METIS takes ≈ 30 % less time
-//! on L, about what the rule's test costs (≈ 0.2 s): the gain is the factor, not the ordering
+//! on L, about what the rule's test costs (0.15–0.2 s): the gain is the factor, not the ordering
 //! time. Eliminating every node of degree ≤ 4 instead was worse on M and L seed 2 (+7 %, +3 %
 //! flops), every node of degree ≤ 6 worse everywhere (+33 % on L).
 #![cfg_attr(not(feature = "metis"), allow(dead_code))]
@@ -39,49 +39,109 @@ pub(super) struct PreElimination {
     pub(super) graph: NodeGraph,
 }
 
-/// The elimination graph as nodes go: each node's list of its own and fill edges (holding
-/// eliminated nodes until it is next read), and for lookups in long lists the graph's own
-/// edges (sorted, bisected) and a set of the fill edges.
+/// The elimination graph as nodes go, for lookups in long lists with the graph's own edges
+/// (sorted, bisected) and a set of the fill edges. Each node's list of its own and fill edges
+/// (holding eliminated nodes until it is next read) lies in one shared array with room to
+/// grow: a candidate reads its neighbours' lists, so they are kept dense (32-bit entries,
+/// no allocation of their own) for the sake of the cache.
 struct EliminationGraph<'g> {
     graph: &'g NodeGraph,
-    adjacent: Vec<Vec<usize>>,
+    lists: Vec<u32>,
+    slot: Vec<Slot>,
     fill: HashSet<(usize, usize)>,
     alive: Vec<bool>,
     degree: Vec<usize>,
 }
 
+/// A node's list in [`EliminationGraph::lists`]: `len` entries from `start`, room for `room`.
+#[derive(Clone, Copy)]
+struct Slot {
+    start: usize,
+    len: u32,
+    room: u32,
+}
+
+/// Room for fill edges each list starts with (it moves to the end of the array, with twice
+/// its room, when full).
+const ROOM_FOR_FILL: usize = 2;
+
 impl<'g> EliminationGraph<'g> {
-    fn new(graph: &'g NodeGraph) -> Self {
+    /// The graph as it is, or None if its nodes do not fit the lists' 32-bit entries.
+    fn new(graph: &'g NodeGraph) -> Option<Self> {
         let m = graph.nodes();
-        EliminationGraph {
+        u32::try_from(m).ok()?;
+        let mut lists = Vec::with_capacity(graph.edges() + m * ROOM_FOR_FILL);
+        let mut slot = Vec::with_capacity(m);
+        for g in 0..m {
+            let own = graph.neighbours(g);
+            slot.push(Slot {
+                start: lists.len(),
+                len: own.len() as u32,
+                room: (own.len() + ROOM_FOR_FILL) as u32,
+            });
+            // Entries are node numbers below m, which fits (checked above).
+            lists.extend(own.iter().map(|&u| u as u32));
+            lists.extend([u32::MAX; ROOM_FOR_FILL]);
+        }
+        Some(EliminationGraph {
             graph,
-            adjacent: (0..m).map(|g| graph.neighbours(g).to_vec()).collect(),
+            lists,
+            slot,
             fill: HashSet::new(),
             alive: vec![true; m],
             degree: (0..m).map(|g| graph.neighbours(g).len()).collect(),
-        }
+        })
     }
 
     /// Whether live nodes `a` and `b` are adjacent: a scan of the shorter list where it is
     /// short, else a bisection of the graph's own edges and a lookup of the fill.
     fn joined(&self, a: usize, b: usize) -> bool {
-        let (short, other) = if self.adjacent[a].len() <= self.adjacent[b].len() {
-            (a, b)
-        } else {
-            (b, a)
-        };
-        if self.adjacent[short].len() <= SCANNED_LIST {
-            return self.adjacent[short].contains(&other);
+        let (sa, sb) = (self.slot[a], self.slot[b]);
+        let (short, other) = if sa.len <= sb.len { (sa, b) } else { (sb, a) };
+        if short.len as usize <= SCANNED_LIST {
+            let list = &self.lists[short.start..short.start + short.len as usize];
+            return list.contains(&(other as u32));
         }
         self.graph.neighbours(a).binary_search(&b).is_ok()
             || self.fill.contains(&(a.min(b), a.max(b)))
     }
 
     /// The live neighbours of `v` (its list pruned of eliminated nodes, once per node each).
-    fn neighbours(&mut self, v: usize) -> &[usize] {
-        let alive = &self.alive;
-        self.adjacent[v].retain(|&u| alive[u]);
-        &self.adjacent[v]
+    fn neighbours(&mut self, v: usize) -> &[u32] {
+        let Slot { start, len, .. } = self.slot[v];
+        let list = &mut self.lists[start..start + len as usize];
+        let mut live = 0;
+        for k in 0..list.len() {
+            if self.alive[list[k] as usize] {
+                list[live] = list[k];
+                live += 1;
+            }
+        }
+        self.slot[v].len = live as u32;
+        &self.lists[start..start + live]
+    }
+
+    /// Appends `u` to `v`'s list: after pruning it if it is full, and at the end of the array
+    /// with twice its room if it is still full.
+    fn push(&mut self, v: usize, u: usize) {
+        if self.slot[v].len == self.slot[v].room {
+            self.neighbours(v);
+        }
+        let s = self.slot[v];
+        if s.len == s.room {
+            let start = self.lists.len();
+            self.lists
+                .extend_from_within(s.start..s.start + s.len as usize);
+            self.lists.resize(start + 2 * s.room as usize, u32::MAX);
+            self.slot[v] = Slot {
+                start,
+                len: s.len,
+                room: 2 * s.room,
+            };
+        }
+        let s = &mut self.slot[v];
+        self.lists[s.start + s.len as usize] = u as u32;
+        s.len += 1;
     }
 
     /// The neighbour pairs of `around` not yet adjacent, into `missing`, or None once there
@@ -115,8 +175,8 @@ impl<'g> EliminationGraph<'g> {
         }
         for &(a, b) in missing {
             self.fill.insert((a.min(b), a.max(b)));
-            self.adjacent[a].push(b);
-            self.adjacent[b].push(a);
+            self.push(a, b);
+            self.push(b, a);
             self.degree[a] += 1;
             self.degree[b] += 1;
         }
@@ -129,7 +189,13 @@ impl<'g> EliminationGraph<'g> {
 /// a bisection or a hash lookup, so a node joined to every other costs no quadratic search.
 pub(super) fn pre_eliminated(graph: &NodeGraph) -> PreElimination {
     let m = graph.nodes();
-    let mut g = EliminationGraph::new(graph);
+    let Some(mut g) = EliminationGraph::new(graph) else {
+        return PreElimination {
+            eliminated: Vec::new(),
+            kept: (0..m).collect(),
+            graph: graph.clone(),
+        };
+    };
     // Lowest degree first; a node is queued again at its new degree when that changes, and a
     // stale entry (eliminated, or at another degree now) is passed over. Within a degree the
     // latest queued goes first, so a tail is eliminated from its free end without fill.
@@ -153,7 +219,9 @@ pub(super) fn pre_eliminated(graph: &NodeGraph) -> PreElimination {
         let live = g.neighbours(v);
         debug_assert_eq!(live.len(), d, "node {v}'s degree");
         let around = &mut around[..live.len()];
-        around.copy_from_slice(live);
+        for (a, &u) in around.iter_mut().zip(live) {
+            *a = u as usize;
+        }
         let Some(missing) = g.missing_pairs(around, around.len().max(1), &mut missing) else {
             continue;
         };
@@ -178,7 +246,7 @@ pub(super) fn pre_eliminated(graph: &NodeGraph) -> PreElimination {
     for &v in &kept {
         starts.push(starts.last().copied().unwrap_or(0) + graph.weight(v));
         let first = edges.len();
-        edges.extend(g.neighbours(v).iter().map(|&u| index[u]));
+        edges.extend(g.neighbours(v).iter().map(|&u| index[u as usize]));
         edges[first..].sort_unstable();
         xadj.push(edges.len());
     }
@@ -267,9 +335,10 @@ mod tests {
         assert_eq!(kept.neighbours(36), [2, 13, 24]);
     }
 
-    /// On scattered graphs (a ring with long chords and triangles), replayed on a dense adjacency matrix: every node eliminated was
-    /// live with degree ≤ the largest tested and fill below max(degree, 1); the graph left is
-    /// the elimination graph, and none of its nodes has degree ≤ 2 (those always qualify).
+    /// On scattered graphs (a ring with long chords and triangles), replayed on a dense
+    /// adjacency matrix: every node eliminated was live with degree ≤ the largest tested and
+    /// fill below max(degree, 1); the graph left is the elimination graph, and none of its
+    /// nodes has degree ≤ 2 (those always qualify).
     #[test]
     fn the_eliminations_follow_the_rule_and_leave_the_elimination_graph() {
         for (m, chords, seed) in [(60, 40, 1u64), (200, 150, 7), (400, 500, 11)] {
