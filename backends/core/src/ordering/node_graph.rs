@@ -19,7 +19,8 @@ use faer::sparse::linalg::amd;
 use faer::sparse::SymbolicSparseColMatRef;
 use rayon::prelude::*;
 
-/// Nodes whose adjacency lists one task of [`NodeGraph::with_groups`] makes.
+/// Columns one task of [`NodeGraph::with_groups`] compares at least, and nodes whose
+/// adjacency lists it makes.
 const NODES_PER_TASK: usize = 4096;
 
 /// A structurally symmetric matrix's graph on its supervariables. Blocks between two
@@ -128,7 +129,7 @@ impl NodeGraph {
         let n = a.ncols();
         let opens: Vec<bool> = (0..n)
             .into_par_iter()
-            .with_min_len(4096)
+            .with_min_len(NODES_PER_TASK)
             .map(|j| j == 0 || a.col(j).0 != a.col(j - 1).0)
             .collect();
         let mut starts = Vec::new();
