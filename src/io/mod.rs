@@ -16,6 +16,7 @@ mod native;
 mod plot;
 mod results;
 mod rve_files;
+mod toml_parts;
 mod vtk;
 
 pub use crate::input_error::InputError;

@@ -1,5 +1,6 @@
 //! The native model format: [`ModelDescription`] through serde, as TOML or JSON.
 
+use super::toml_parts::{parse_in_parts, PARTS_FROM_BYTES};
 use super::InputError;
 use crate::model::ModelDescription;
 
@@ -10,10 +11,22 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
     (line, column)
 }
 
-/// Parses a TOML model; errors carry line and column.
+/// Parses a TOML model; errors carry line and column. A large one is parsed in parts on all
+/// threads where the parts must give the whole document's description
+/// (cut at `[[nodes]]` and `[[fibers]]` header lines, each part parsed alone; any doubt, and
+/// every error, goes to the whole document), else whole.
 pub fn parse_toml(text: &str, path: &str) -> Result<ModelDescription, InputError> {
+    let threads = rayon::current_num_threads();
+    if text.len() >= PARTS_FROM_BYTES && threads > 1 {
+        if let Some(d) = parse_in_parts(text, PARTS_PER_THREAD * threads) {
+            return Ok(d);
+        }
+    }
     parse_toml_as(text, path)
 }
+
+/// Parts per thread of a large TOML model (they differ in how long their entries take).
+const PARTS_PER_THREAD: usize = 2;
 
 /// Parses any TOML document into `T` (a model, generator parameters); errors carry line and
 /// column.
