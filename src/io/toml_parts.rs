@@ -1,6 +1,6 @@
 //! A large TOML model parsed in parts on all threads.
 //!
-//! toml reads a document at about 20–30 MB/s on one core (the L non-woven's 16 MB in ≈ 0.5 s).
+//! toml reads a document at about 20–30 MB/s on one core (the L non-woven's 16 MB in 0.5–0.9 s).
 //! A model file is mostly `[[nodes]]` and `[[fibers]]` entries, and a line holding exactly one
 //! of those headers starts a self-contained TOML document: whatever follows it up to the next
 //! header belongs to that one entry. So the text is cut at such lines into parts of about
@@ -55,50 +55,43 @@ fn cut_points(text: &str, parts: usize) -> Vec<usize> {
     for k in 1..parts {
         let from = (text.len() * k / parts).max(cuts[cuts.len() - 1] + 1);
         match next_header_line(text, from) {
-            Some(at) if at < text.len() => cuts.push(at),
-            _ => break,
+            Some(at) => cuts.push(at),
+            None => break,
         }
     }
-    cuts.dedup();
     cuts.push(text.len());
     cuts
 }
 
-/// The start of the first line at or after byte `from` that is exactly a header of
-/// [`HEADERS`] (a trailing carriage return or blanks allowed).
+/// The start of the first line at or after byte `from` that is a header of [`HEADERS`].
 fn next_header_line(text: &str, from: usize) -> Option<usize> {
     let bytes = text.as_bytes();
-    let mut at = from;
-    while at < bytes.len() {
-        // A line start: the text's beginning or just after a newline.
-        let start = if at == 0 || bytes[at - 1] == b'\n' {
-            at
-        } else {
-            at + bytes[at..].iter().position(|&b| b == b'\n')? + 1
-        };
-        let end = bytes[start..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |p| start + p);
-        if is_header(&text[start..end]) {
+    let mut start = if from == 0 || bytes[from - 1] == b'\n' {
+        from
+    } else {
+        from + bytes[from..].iter().position(|&b| b == b'\n')? + 1
+    };
+    for line in text[start..].split_inclusive('\n') {
+        if header(line).is_some() {
             return Some(start);
         }
-        at = end + 1;
+        start += line.len();
     }
     None
 }
 
-fn is_header(line: &str) -> bool {
-    HEADERS.contains(&line.trim_end())
+/// Which of [`HEADERS`] `line` is exactly (trailing blanks, a carriage return or the newline
+/// allowed).
+fn header(line: &str) -> Option<usize> {
+    let line = line.trim_end();
+    HEADERS.iter().position(|h| *h == line)
 }
 
 /// The `[[nodes]]` and `[[fibers]]` header lines of `part`.
 fn header_lines(part: &str) -> [usize; 2] {
     let mut counts = [0; 2];
-    for line in part.lines() {
-        if let Some(k) = HEADERS.iter().position(|h| *h == line.trim_end()) {
-            counts[k] += 1;
-        }
+    for k in part.lines().filter_map(header) {
+        counts[k] += 1;
     }
     counts
 }
@@ -130,25 +123,23 @@ fn append(whole: &mut ModelDescription, part: ModelDescription) -> Option<()> {
 }
 
 fn once<T>(whole: &mut Option<T>, part: Option<T>) -> Option<()> {
-    match (whole.is_some(), part) {
-        (true, Some(_)) => None,
-        (_, Some(p)) => {
-            *whole = Some(p);
-            Some(())
+    if part.is_some() {
+        if whole.is_some() {
+            return None;
         }
-        (_, None) => Some(()),
+        *whole = part;
     }
+    Some(())
 }
 
 fn once_list<T>(whole: &mut Vec<T>, part: Vec<T>) -> Option<()> {
-    match (whole.is_empty(), part.is_empty()) {
-        (_, true) => Some(()),
-        (true, false) => {
-            *whole = part;
-            Some(())
+    if !part.is_empty() {
+        if !whole.is_empty() {
+            return None;
         }
-        (false, false) => None,
+        *whole = part;
     }
+    Some(())
 }
 
 #[cfg(test)]
@@ -193,7 +184,10 @@ mod tests {
             assert_eq!(cuts.len(), parts + 1, "{parts} parts");
             assert!(cuts.windows(2).all(|w| w[0] < w[1]));
             for &c in &cuts[1..parts] {
-                assert!(is_header(text[c..].lines().next().unwrap()), "cut at {c}");
+                assert!(
+                    header(text[c..].lines().next().unwrap()).is_some(),
+                    "cut at {c}"
+                );
             }
             assert_eq!(parse_in_parts(&text, parts).as_ref(), Some(&expected));
         }
