@@ -152,8 +152,9 @@ mod tests {
         CscMatrix::from_triplets(k * k * dofs, k * k * dofs, &t).unwrap()
     }
 
-    /// Nested dissection gives the same permutation when several threads order at once
-    /// (METIS draws from one process-wide random state).
+    /// Nested dissection gives the same permutation when several threads order at once (each
+    /// METIS call draws from its own thread's seeded state: vendor/metis-sys/PATCHES.md; with
+    /// crates.io's metis-sys, which draws from the C library's `rand`, this test fails).
     #[cfg(feature = "metis")]
     #[test]
     fn nested_dissection_is_the_same_on_concurrent_threads() {
