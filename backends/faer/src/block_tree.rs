@@ -66,7 +66,7 @@ fn raw_shape(symbolic: &Symbolic, s: usize) -> BlockShape {
             BlockShape {
                 begin,
                 width: f.supernode_end()[s] - begin,
-                pattern: first..first + f.supernode(s).pattern().len(),
+                pattern: first..first + f.pattern(s).len(),
                 values: f.col_ptr_for_val()[s]..f.col_ptr_for_val()[s + 1],
             }
         }

@@ -13,7 +13,8 @@ use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
 use crate::prefault::{PrefaultedValues, PREFAULT_BYTES};
 use crate::supernodal_llt::{self, ScaledMatrix, SupernodalPlan, TaskSizes};
-use crate::symbolic::{supernodal_of_node_tree, Raw, Symbolic};
+use crate::supernodes::Supernodes;
+use crate::symbolic::{internal, supernodal_fill, supernodal_of_node_tree, Raw, Symbolic};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
@@ -60,6 +61,8 @@ pub struct FaerCholesky {
     work: Vec<f64>,
     /// Factors of at least this many bytes get a prefaulted first buffer.
     prefault_bytes: usize,
+    /// LLᵀ factors of at least this many entries take this crate's supernodes.
+    own_supernodes_from: usize,
     /// The first factorization's value buffer, mapped since the analysis began.
     prefaulted: Option<PrefaultedValues>,
 }
@@ -80,6 +83,14 @@ struct Analysis {
     factor_inv: Vec<usize>,
     /// Which numeric kernel factorizes, with what it reads.
     kernel: Kernel,
+}
+
+impl Analysis {
+    /// Whether an LLᵀ factor is solved by this crate's block solves: a factor split over the
+    /// threads, and every factor on this crate's supernodes.
+    fn block_solves(&self) -> bool {
+        self.schedule.is_parallel() || self.symbolic.is_ours()
+    }
 }
 
 /// The numeric kernel of an analysis.
@@ -119,6 +130,13 @@ impl Workspace {
 /// fresh pages against 5·10¹⁰ flops in 4–6 s); it was not timed apart.
 const KEPT_WORKSPACE_BYTES: usize = 64 << 20;
 
+/// LLᵀ factors with at least this many entries, ordered on the node graph, take this crate's
+/// supernodes ([`Supernodes::of_node_tree`]) instead of faer's supernodal step: their solves
+/// are this crate's block solves anyway (`block_kernels::PARALLEL_VALUES`), and there faer's
+/// step costs most (0.06–0.36 s on the L non-woven). Smaller factors keep faer's structure
+/// for faer's solves, which are faster on a factor that fits in cache.
+const OWN_SUPERNODES_FROM: usize = 1 << 20;
+
 impl Default for FaerCholesky {
     fn default() -> Self {
         Self::new(CholeskyVariant::Llt, FillOrdering::Auto)
@@ -149,6 +167,7 @@ impl FaerCholesky {
             workspace: None,
             work: Vec::new(),
             prefault_bytes: PREFAULT_BYTES,
+            own_supernodes_from: OWN_SUPERNODES_FROM,
             prefaulted: None,
         }
     }
@@ -157,6 +176,13 @@ impl FaerCholesky {
     #[cfg(test)]
     pub(crate) fn with_prefault_bytes(mut self, bytes: usize) -> Self {
         self.prefault_bytes = bytes;
+        self
+    }
+
+    /// Builds this crate's supernodes for LLᵀ factors from `entries` of L on (tests).
+    #[cfg(test)]
+    pub(crate) fn with_own_supernodes_from(mut self, entries: usize) -> Self {
+        self.own_supernodes_from = entries;
         self
     }
 
@@ -251,9 +277,9 @@ impl FaerCholesky {
         }
     }
 
-    /// The symbolic factor of `a` under `perm`: faer's supernodal step on the node tree where
-    /// the ordering was made on the node graph and the factor is supernodal, else faer's own
-    /// analysis.
+    /// The symbolic factor of `a` under `perm`: where the ordering was made on the node graph
+    /// and the factor is supernodal, this crate's supernodes for a large LLᵀ factor and faer's
+    /// supernodal step on the node tree for the rest; else faer's own analysis.
     fn symbolic(
         &self,
         a: CscRef<'_>,
@@ -261,6 +287,10 @@ impl FaerCholesky {
         order: Option<&NodeOrder>,
     ) -> Result<Symbolic, SolverError> {
         if let Some(o) = order {
+            let large = o.fill.nnz_l >= self.own_supernodes_from;
+            if self.variant == CholeskyVariant::Llt && large && supernodal_fill(&o.fill) {
+                return Supernodes::of_node_tree(&o.graph, &o.tree).map(Symbolic::Nodes);
+            }
             if let Some(sn) = supernodal_of_node_tree(&o.graph, &o.tree)? {
                 return Ok(Symbolic::Supernodal(sn));
             }
@@ -426,7 +456,7 @@ impl LinearSolver for FaerCholesky {
                 Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
                 None => ((0..n).collect(), (0..n).collect()),
             },
-            Symbolic::Supernodal(_) => (perm.fwd.clone(), perm.inv.clone()),
+            Symbolic::Supernodal(_) | Symbolic::Nodes(_) => (perm.fwd.clone(), perm.inv.clone()),
         };
         let plan = match (self.variant, symbolic.raw()) {
             (CholeskyVariant::Llt, Raw::Supernodal(sn)) => {
@@ -435,6 +465,10 @@ impl LinearSolver for FaerCholesky {
             _ => None,
         };
         debug_assert_eq!(factor_inv, perm.inv);
+        if plan.is_none() && symbolic.is_ours() {
+            // Only past 2³² columns, which no factor in memory reaches.
+            return Err(internal("no task plan for this crate's supernodes"));
+        }
         let kernel = match plan {
             Some(plan) => Kernel::Tasks(plan),
             None if is_simplicial(&symbolic) => Kernel::Faer(LowerTriangle::of(a)),
@@ -487,15 +521,15 @@ impl LinearSolver for FaerCholesky {
         let mut ws = match self.workspace.take() {
             Some(ws) => ws,
             None => {
-                let req = match (self.variant, an.symbolic.raw()) {
-                    (CholeskyVariant::Llt, Raw::Supernodal(sn)) => {
+                let req = match (self.variant, an.symbolic.faer_supernodal()) {
+                    (CholeskyVariant::Llt, Some(sn)) => {
                         supernodal::factorize_supernodal_numeric_llt_scratch::<usize, f64>(
                             sn,
                             self.par,
                             Spec::default(),
                         )
                     }
-                    (CholeskyVariant::Ldlt, Raw::Supernodal(sn)) => {
+                    (CholeskyVariant::Ldlt, Some(sn)) => {
                         supernodal::factorize_supernodal_numeric_ldlt_scratch::<usize, f64>(
                             sn,
                             self.par,
@@ -517,7 +551,7 @@ impl LinearSolver for FaerCholesky {
                 }
             }
         };
-        let supernodal = an.symbolic.supernodal();
+        let supernodal = an.symbolic.faer_supernodal();
         if supernodal.is_some() {
             lower.scaled_permuted_values(a, &an.factor_fwd, &mut f.scale, &mut ws.lower_values)?;
         } else {
@@ -630,6 +664,7 @@ impl LinearSolver for FaerCholesky {
             workspace: None,
             work: Vec::new(),
             prefault_bytes: self.prefault_bytes,
+            own_supernodes_from: self.own_supernodes_from,
             prefaulted: None,
         }))
     }
@@ -644,7 +679,7 @@ impl LinearSolver for FaerCholesky {
         if n == 0 {
             return Ok(SolveInfo::default());
         }
-        if nrhs == 1 && self.variant == CholeskyVariant::Llt && an.schedule.is_parallel() {
+        if nrhs == 1 && self.variant == CholeskyVariant::Llt && an.block_solves() {
             // One right-hand side on a factor large enough to split over the threads: our
             // block solve (faer's runs at a quarter of the bandwidth; on a factor that fits in
             // cache faer's kernels are faster).
@@ -656,7 +691,7 @@ impl LinearSolver for FaerCholesky {
             self.work = x;
             return Ok(SolveInfo::default());
         }
-        if self.variant == CholeskyVariant::Llt && an.schedule.is_parallel() {
+        if self.variant == CholeskyVariant::Llt && an.block_solves() {
             // Several right-hand sides on a factor split over the threads: all columns through
             // each block at once (faer's solve reads the factor once per column group). The
             // buffer is not kept: shared solvers of many material points would each hold one.
@@ -689,8 +724,8 @@ impl LinearSolver for FaerCholesky {
             (self.par, nrhs)
         };
         let variant = self.variant;
-        match an.symbolic.raw() {
-            Raw::Supernodal(sn) => {
+        match an.symbolic.faer_supernodal() {
+            Some(sn) => {
                 // faer's supernodal solve in the factor's order: columns permuted and scaled
                 // into a copy, solved, and back.
                 let mut x = vec![0.0; n * nrhs];
@@ -715,7 +750,7 @@ impl LinearSolver for FaerCholesky {
                     permute::from_factor_order(y, &f.scale, &an.factor_inv, b, parallel);
                 }
             }
-            Raw::Simplicial(_) => {
+            None => {
                 let sym = an.symbolic.faer()?;
                 for col in rhs.chunks_mut(n) {
                     col.iter_mut().zip(&f.scale).for_each(|(x, s)| *x *= s);
@@ -849,6 +884,76 @@ mod tests {
                         "{variant:?}, {k} columns, column {c}"
                     );
                 }
+            }
+        }
+    }
+
+    /// A large LLᵀ factor (here forced on small ones) takes this crate's supernodes; its
+    /// analysis reports what faer's structure gives, its factor is faer's structure's bit for
+    /// bit, and every solve — one and several right-hand sides, the two halves, sparse
+    /// forward columns — agrees with the solves on faer's structure, on two threads and on
+    /// one (where the block solves run without a parallel schedule).
+    #[test]
+    fn own_supernodes_factorize_and_solve_as_faers() {
+        let close = |p: &[f64], q: &[f64], what: &str| {
+            let scale = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let diff = p
+                .iter()
+                .zip(q)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(diff <= 1e-12 * scale, "{what}: {diff:e} of {scale:e}");
+        };
+        for (name, a) in [("network", blocked_network(3000)), ("grid", grid(14))] {
+            let n = a.as_ref().ncols();
+            for sequential in [false, true] {
+                let what = format!("{name}, sequential {sequential}");
+                let make = |from: usize| {
+                    let s = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::Auto)
+                        .with_own_supernodes_from(from);
+                    if sequential {
+                        s.sequential()
+                    } else {
+                        s
+                    }
+                };
+                let (mut ours, mut theirs) = (make(0), make(usize::MAX));
+                let info = ours.analyze(a.as_ref()).unwrap();
+                assert_eq!(info, theirs.analyze(a.as_ref()).unwrap(), "{what}");
+                ours.factorize(a.as_ref()).unwrap();
+                theirs.factorize(a.as_ref()).unwrap();
+                let is_ours = |s: &FaerCholesky| s.analysis.as_ref().unwrap().symbolic.is_ours();
+                assert!(is_ours(&ours) && !is_ours(&theirs), "{what}");
+                assert_eq!(
+                    ours.factor_view().values,
+                    theirs.factor_view().values,
+                    "{what}"
+                );
+                for k in [1, 3] {
+                    let b: Vec<f64> = (0..n * k).map(|i| ((i * 37) % 101) as f64 - 50.0).collect();
+                    let (mut x, mut y) = (b.clone(), b.clone());
+                    ours.solve_in_place(&mut x, k).unwrap();
+                    theirs.solve_in_place(&mut y, k).unwrap();
+                    close(&x, &y, &format!("{what}, {k} columns"));
+                    for (xc, bc) in x.chunks(n).zip(b.chunks(n)) {
+                        // The grid's scales span four decades: 1e-11 with either structure.
+                        let r = relative_residual(&a, xc, bc);
+                        assert!(r < 1e-10, "{what}, {k} columns: {r:e}");
+                    }
+                }
+                let b: Vec<f64> = (0..n).map(|i| ((i * 29) % 97) as f64 - 48.0).collect();
+                let (mut x, mut y) = (b.clone(), b.clone());
+                ours.solve_lower_in_place(&mut x).unwrap();
+                theirs.solve_lower_in_place(&mut y).unwrap();
+                close(&x, &y, &format!("{what}, lower half"));
+                ours.solve_upper_in_place(&mut x).unwrap();
+                theirs.solve_upper_in_place(&mut y).unwrap();
+                close(&x, &y, &format!("{what}, upper half"));
+                let columns = vec![vec![(3, 1.0), (40, -2.0)], vec![(n - 1, 0.5)]];
+                close(
+                    &ours.forward_solve_sparse(&columns).unwrap().gram(),
+                    &theirs.forward_solve_sparse(&columns).unwrap().gram(),
+                    &format!("{what}, sparse forward"),
+                );
             }
         }
     }

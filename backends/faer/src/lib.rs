@@ -43,6 +43,7 @@ mod prefault;
 mod prefetch;
 mod sparse_forward;
 mod supernodal_llt;
+mod supernodes;
 mod symbolic;
 #[cfg(test)]
 mod test_matrices;

@@ -1,14 +1,12 @@
 //! Reading the pivots back out of a faer Cholesky factor, to catch (near-)zero pivots that
 //! faer accepts, and to count fill and flops.
 
+use crate::supernodes::SupernodesRef;
 use crate::symbolic::{Raw, Symbolic};
-use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
-
-type SupernodalSymbolic = SymbolicSupernodalCholesky<usize>;
 
 /// Each supernode as (first column, end column, rows of its dense block, first value index).
 pub(crate) fn supernodes(
-    s: &SupernodalSymbolic,
+    s: SupernodesRef<'_>,
 ) -> impl Iterator<Item = (usize, usize, usize, usize)> + '_ {
     (0..s.n_supernodes()).map(move |k| {
         let (b, e) = (s.supernode_begin()[k], s.supernode_end()[k]);

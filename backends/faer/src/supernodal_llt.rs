@@ -10,6 +10,7 @@
 //! CHOLMOD's supernodal numeric factorization): gather A's columns, subtract every descendant's
 //! update L_d,bottom L_d,midᵀ, factorize the diagonal block and solve the rows below it.
 
+use crate::supernodes::SupernodesRef;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{
     cholesky_in_place, cholesky_in_place_scratch, LltError, LltRegularization,
@@ -17,7 +18,6 @@ use faer::linalg::cholesky::llt::factor::{
 use faer::linalg::matmul::{matmul, triangular};
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{Reborrow, ReborrowMut};
-use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::{Accum, MatMut, MatRef, Par, Spec};
 use fibercell_solver::CscRef;
 use std::marker::PhantomData;
@@ -25,7 +25,7 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-type Symbolic = SymbolicSupernodalCholesky<usize>;
+type Symbolic<'a> = SupernodesRef<'a>;
 
 /// No parent (a root of the supernodal forest).
 const NONE: usize = usize::MAX;
@@ -75,7 +75,7 @@ impl SupernodalPlan {
     /// The plan of `sym`, or `None` when a supernode's parent does not come after it (which
     /// an elimination tree's numbering guarantees; the tasks rely on it) or the columns do
     /// not fit 32-bit indices.
-    pub(crate) fn new(sym: &Symbolic, threads: usize, sizes: TaskSizes) -> Option<Self> {
+    pub(crate) fn new(sym: Symbolic<'_>, threads: usize, sizes: TaskSizes) -> Option<Self> {
         let ns = sym.n_supernodes();
         if u32::try_from(sym.nrows()).is_err() {
             return None;
@@ -126,7 +126,7 @@ impl SupernodalPlan {
 }
 
 /// The supernode of every column.
-fn block_of_columns(sym: &Symbolic) -> Vec<usize> {
+fn block_of_columns(sym: Symbolic<'_>) -> Vec<usize> {
     let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
     let mut block_of = vec![0usize; sym.nrows()];
     for s in 0..sym.n_supernodes() {
@@ -137,10 +137,10 @@ fn block_of_columns(sym: &Symbolic) -> Vec<usize> {
 
 /// Each supernode's parent (the supernode of its first off-diagonal row) and own work
 /// Σ c_j² over its columns.
-fn tree(sym: &Symbolic, block_of: &[usize]) -> (Vec<usize>, Vec<f64>) {
+fn tree(sym: Symbolic<'_>, block_of: &[usize]) -> (Vec<usize>, Vec<f64>) {
     (0..sym.n_supernodes())
         .map(|s| {
-            let pattern = sym.supernode(s).pattern();
+            let pattern = sym.pattern(s);
             let width = sym.supernode_end()[s] - sym.supernode_begin()[s];
             let rows = (width + pattern.len()) as f64;
             let own: f64 = (0..width).map(|c| (rows - c as f64).powi(2)).sum();
@@ -151,11 +151,11 @@ fn tree(sym: &Symbolic, block_of: &[usize]) -> (Vec<usize>, Vec<f64>) {
 
 /// For every supernode s, the descendants d with a row in s's columns (ascending), in CSR
 /// form: the supernodes that d's pattern touches.
-fn updaters(sym: &Symbolic, block_of: &[usize]) -> (Vec<usize>, Vec<u32>) {
+fn updaters(sym: Symbolic<'_>, block_of: &[usize]) -> (Vec<usize>, Vec<u32>) {
     let ns = sym.n_supernodes();
     let touched = |d: usize| {
         let mut last = NONE;
-        sym.supernode(d).pattern().iter().filter_map(move |&r| {
+        sym.pattern(d).iter().filter_map(move |&r| {
             let t = block_of[r];
             (t != last).then(|| {
                 last = t;
@@ -337,7 +337,7 @@ impl Failure {
 /// What every task reads: the symbolic factor, A's lower triangle in the factor's order, the
 /// plan, the factor being written and the failure flag.
 struct Context<'a> {
-    sym: &'a Symbolic,
+    sym: Symbolic<'a>,
     a: ScaledMatrix<'a>,
     pivot_tolerance: f64,
     plan: &'a SupernodalPlan,
@@ -356,7 +356,7 @@ pub(crate) fn factorize_llt(
     values: &mut [f64],
     a: ScaledMatrix<'_>,
     pivot_tolerance: f64,
-    sym: &Symbolic,
+    sym: Symbolic<'_>,
     plan: &SupernodalPlan,
     threads: usize,
 ) -> Result<(), Pivot> {
@@ -475,7 +475,7 @@ impl<'a> Context<'a> {
     fn shape(&self, s: usize) -> (std::ops::Range<usize>, usize, usize, &'a [usize]) {
         let sym = self.sym;
         let (b, e) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
-        let pattern = sym.supernode(s).pattern();
+        let pattern = sym.pattern(s);
         let values = sym.col_ptr_for_val()[s]..sym.col_ptr_for_val()[s + 1];
         (values, e - b, e - b + pattern.len(), pattern)
     }
@@ -662,8 +662,8 @@ mod tests {
     use super::*;
     use crate::test_matrices::grid;
     use faer::sparse::linalg::cholesky::{
-        factorize_symbolic_cholesky, supernodal, CholeskySymbolicParams, SymbolicCholesky,
-        SymbolicCholeskyRaw, SymmetricOrdering,
+        factorize_symbolic_cholesky, supernodal, supernodal::SymbolicSupernodalCholesky,
+        CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
     };
     use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
     use faer::Side;
@@ -715,16 +715,20 @@ mod tests {
             }
         }
 
-        fn supernodal(&self) -> &Symbolic {
+        fn faer_supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
             match self.sym.raw() {
                 SymbolicCholeskyRaw::Supernodal(sn) => sn,
                 SymbolicCholeskyRaw::Simplicial(_) => panic!("forced supernodal"),
             }
         }
 
+        fn supernodal(&self) -> Symbolic<'_> {
+            SupernodesRef::of_faer(self.faer_supernodal())
+        }
+
         /// faer's sequential supernodal kernel on the scaled copy.
         fn faer_llt(&self) -> Result<Vec<f64>, LltError> {
-            let sn = self.supernodal();
+            let sn = self.faer_supernodal();
             let n = sn.nrows();
             let lower = &self.lower;
             let a = SparseColMatRef::new(

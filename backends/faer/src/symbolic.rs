@@ -1,13 +1,17 @@
-//! The symbolic factor an analysis keeps: faer's own analysis, or faer's supernodal structure
-//! built from the node graph's elimination tree without a scalar analysis.
+//! The symbolic factor an analysis keeps: faer's own analysis, faer's supernodal structure
+//! built from the node graph's elimination tree without a scalar analysis, or this crate's
+//! supernodes built from that tree alone ([`Supernodes`]).
 //!
 //! faer's `factorize_symbolic_cholesky` permutes the scalar pattern, computes the scalar
 //! elimination tree and column counts, then the supernodes (on the L non-woven, n = 934,683,
 //! ≈ 0.35 s on one core). For an ordering made on the node graph the tree and counts are the
 //! node tree's expanded ([`fibercell_solver::NodeTree::scalar_tree`]) and the supernodes'
 //! rows follow from one entry per neighbour node ([`fibercell_solver::NodeTree::reach_pattern`]),
-//! so faer's supernodal step runs on that alone and gives the same structure.
+//! so faer's supernodal step runs on that alone and gives the same structure; faer's LDLᵀ and
+//! small LLᵀ factors, whose kernels and solves are faer's, keep that. A large LLᵀ factor,
+//! factorized and solved by this crate's kernels only, takes [`Supernodes::of_node_tree`].
 
+use crate::supernodes::{Supernodes, SupernodesRef};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::simplicial::{EliminationTreeRef, SymbolicSimplicialCholesky};
 use faer::sparse::linalg::cholesky::supernodal::{
@@ -17,21 +21,24 @@ use faer::sparse::linalg::cholesky::supernodal::{
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::linalg::SymbolicSupernodalParams;
 use faer::sparse::SymbolicSparseColMatRef;
-use fibercell_solver::{NodeGraph, NodeTree, SolverError};
+use fibercell_solver::{FillEstimate, NodeGraph, NodeTree, SolverError};
 
 /// A symbolic Cholesky factor.
 pub(crate) enum Symbolic {
     /// faer's analysis of the matrix (it holds the permutation and permutes in its solves).
     Faer(SymbolicCholesky<usize>),
-    /// Supernodes of the matrix already in the factor's order (the caller permutes).
+    /// faer's supernodes of the matrix already in the factor's order (the caller permutes).
     Supernodal(SymbolicSupernodalCholesky<usize>),
+    /// This crate's supernodes, the same as faer's, in the factor's order: for this crate's
+    /// LLᵀ kernel and block solves only.
+    Nodes(Supernodes),
 }
 
 /// The structure of a [`Symbolic`].
 #[derive(Clone, Copy)]
 pub(crate) enum Raw<'a> {
     Simplicial(&'a SymbolicSimplicialCholesky<usize>),
-    Supernodal(&'a SymbolicSupernodalCholesky<usize>),
+    Supernodal(SupernodesRef<'a>),
 }
 
 impl Symbolic {
@@ -39,25 +46,44 @@ impl Symbolic {
         match self {
             Symbolic::Faer(s) => match s.raw() {
                 SymbolicCholeskyRaw::Simplicial(f) => Raw::Simplicial(f),
-                SymbolicCholeskyRaw::Supernodal(f) => Raw::Supernodal(f),
+                SymbolicCholeskyRaw::Supernodal(f) => Raw::Supernodal(SupernodesRef::of_faer(f)),
             },
-            Symbolic::Supernodal(f) => Raw::Supernodal(f),
+            Symbolic::Supernodal(f) => Raw::Supernodal(SupernodesRef::of_faer(f)),
+            Symbolic::Nodes(s) => Raw::Supernodal(s.as_ref()),
         }
     }
 
     /// The supernodal structure, if the factor is supernodal.
-    pub(crate) fn supernodal(&self) -> Option<&SymbolicSupernodalCholesky<usize>> {
+    pub(crate) fn supernodal(&self) -> Option<SupernodesRef<'_>> {
         match self.raw() {
             Raw::Supernodal(f) => Some(f),
             Raw::Simplicial(_) => None,
         }
     }
 
+    /// faer's supernodal structure, which faer's supernodal kernels and solves take; `None`
+    /// for a simplicial factor or this crate's [`Supernodes`].
+    pub(crate) fn faer_supernodal(&self) -> Option<&SymbolicSupernodalCholesky<usize>> {
+        match self {
+            Symbolic::Faer(s) => match s.raw() {
+                SymbolicCholeskyRaw::Supernodal(f) => Some(f),
+                SymbolicCholeskyRaw::Simplicial(_) => None,
+            },
+            Symbolic::Supernodal(f) => Some(f),
+            Symbolic::Nodes(_) => None,
+        }
+    }
+
+    /// Whether only this crate's kernel and block solves can read the factor.
+    pub(crate) fn is_ours(&self) -> bool {
+        matches!(self, Symbolic::Nodes(_))
+    }
+
     /// faer's own analysis: the simplicial factors' (only faer's analysis makes those).
     pub(crate) fn faer(&self) -> Result<&SymbolicCholesky<usize>, SolverError> {
         match self {
             Symbolic::Faer(s) => Ok(s),
-            Symbolic::Supernodal(_) => Err(internal(
+            Symbolic::Supernodal(_) | Symbolic::Nodes(_) => Err(internal(
                 "a simplicial step on a node-tree supernodal structure",
             )),
         }
@@ -84,6 +110,13 @@ impl Symbolic {
 /// `CHOLESKY_SUPERNODAL_RATIO_FACTOR` at the default `SupernodalThreshold::AUTO`), flops
 /// counted as faer does, Σ c + c(c + 1)/2 over the column counts c.
 const SUPERNODAL_FLOPS_PER_ENTRY: f64 = 40.0;
+
+/// Whether faer makes a supernodal factor of this fill: its flop count Σ c + c(c + 1)/2 is
+/// Σ c²/2 + 3/2 Σ c over the column counts c.
+pub(crate) fn supernodal_fill(fill: &FillEstimate) -> bool {
+    let entries = fill.nnz_l as f64;
+    fill.nnz_l > 0 && (fill.flops / 2.0 + 1.5 * entries) / entries > SUPERNODAL_FLOPS_PER_ENTRY
+}
 
 /// faer's supernodal structure of the matrix permuted by `tree`'s order (in that order), from
 /// the node tree; `None` where faer would make a simplicial factor (then its own analysis
@@ -134,7 +167,7 @@ pub(crate) fn supernodal_of_node_tree(
     .map_err(|e| internal(&format!("supernodal symbolic factorization failed: {e:?}")))
 }
 
-fn internal(message: &str) -> SolverError {
+pub(crate) fn internal(message: &str) -> SolverError {
     SolverError::Backend {
         backend: "faer-cholesky",
         code: -4,
@@ -145,7 +178,8 @@ fn internal(message: &str) -> SolverError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_matrices::{blocked_network, grid};
+    use crate::supernodes::assert_same_supernodes;
+    use crate::test_matrices::structure_cases;
     use faer::perm::PermRef;
     use faer::sparse::linalg::cholesky::{
         factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
@@ -174,16 +208,7 @@ mod tests {
     /// mixed node widths and on a scalar grid; where faer makes a simplicial factor, none.
     #[test]
     fn the_node_tree_gives_faers_supernodal_structure() {
-        let mut cases = vec![
-            ("network 3", blocked_network(3)),
-            ("network 40", blocked_network(40)),
-            ("network 400", blocked_network(400)),
-            ("network 3000", blocked_network(3000)),
-            ("grid 3", grid(3)),
-            ("grid 12", grid(12)),
-            ("grid 20", grid(20)),
-        ];
-        cases.push(("network 1", blocked_network(1)));
+        let cases = structure_cases();
         let mut supernodal = 0;
         for (name, a) in &cases {
             let g = NodeGraph::of(a.as_ref()).unwrap();
@@ -204,14 +229,7 @@ mod tests {
                 };
                 let theirs = theirs.supernodal().unwrap();
                 let what = format!("{name}, {}", o.name());
-                assert_eq!(ours.supernode_begin(), theirs.supernode_begin(), "{what}");
-                assert_eq!(
-                    ours.col_ptr_for_row_idx(),
-                    theirs.col_ptr_for_row_idx(),
-                    "{what}"
-                );
-                assert_eq!(ours.col_ptr_for_val(), theirs.col_ptr_for_val(), "{what}");
-                assert_eq!(ours.row_idx(), theirs.row_idx(), "{what}");
+                assert_same_supernodes(SupernodesRef::of_faer(&ours), theirs, &what);
                 supernodal += 1;
             }
         }

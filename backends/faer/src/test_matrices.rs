@@ -93,3 +93,18 @@ pub(crate) fn blocked_network(m: usize) -> CscMatrix {
     }
     CscMatrix::from_triplets(n, n, &t).unwrap()
 }
+
+/// Networks of mixed node widths (1 to 3000 nodes) and scalar grids (3³ to 20³): the cases of
+/// the structure tests.
+pub(crate) fn structure_cases() -> Vec<(&'static str, CscMatrix)> {
+    vec![
+        ("network 1", blocked_network(1)),
+        ("network 3", blocked_network(3)),
+        ("network 40", blocked_network(40)),
+        ("network 400", blocked_network(400)),
+        ("network 3000", blocked_network(3000)),
+        ("grid 3", grid(3)),
+        ("grid 12", grid(12)),
+        ("grid 20", grid(20)),
+    ]
+}

@@ -4,7 +4,8 @@
 
 /// Bottom first; a module may import the ones of lower layers only.
 const LAYERS: &[&[&str]] = &[
-    &["prefault", "symbolic"],
+    &["prefault", "supernodes"],
+    &["symbolic"],
     &[
         "block_tree",
         "column_layout",

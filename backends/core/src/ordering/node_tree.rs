@@ -43,8 +43,19 @@ impl NodeTree {
         &self.nodes
     }
 
+    /// Each position's parent position; a root is its own parent. A parent comes after its
+    /// children (the order is postordered).
+    pub fn parents(&self) -> &[usize] {
+        &self.parent
+    }
+
+    /// Unknowns below each position's diagonal block in L.
+    pub fn below(&self) -> &[usize] {
+        &self.below
+    }
+
     /// The first scalar column of each position, and n at the end.
-    fn column_starts(&self, graph: &NodeGraph) -> Vec<usize> {
+    pub fn column_starts(&self, graph: &NodeGraph) -> Vec<usize> {
         let mut starts = Vec::with_capacity(self.nodes.len() + 1);
         starts.push(0);
         for &g in &self.nodes {
