@@ -65,55 +65,41 @@ pub struct FillEstimate {
 
 impl NodeGraph {
     /// The node graph of `a`, whose pattern must be square and symmetric (checked: AMD and
-    /// METIS hang or return nonsense on one triangle). The check runs on the nodes
-    /// (`NodeGraph::groups_a_symmetric_pattern`: one lookup per node edge, not per entry, on
-    /// a beam network); only a refused pattern goes through
-    /// [`CscRef::check_structurally_symmetric`], for the first entry without its mirror.
-    pub fn of(a: CscRef<'_>) -> Result<Self, SolverError> {
-        if a.nrows() != a.ncols() {
-            a.check_structurally_symmetric()?;
-        }
-        let (graph, group) = Self::with_groups(a);
-        if !graph.groups_a_symmetric_pattern(a, &group) {
-            a.check_structurally_symmetric()?;
-        }
-        Ok(graph)
-    }
-
-    /// Whether the square pattern of `a`, grouped into this graph's nodes by
-    /// [`NodeGraph::with_groups`] (consecutive columns with identical patterns; `group[j]` the
-    /// node of column j), is symmetric: exactly when (i) every node's pattern is made of whole
-    /// nodes (it holds all rows of a node or none) and (ii) the node adjacency is symmetric.
+    /// METIS hang or return nonsense on one triangle). The check runs on the nodes while
+    /// they are made (see [`NodeGraph::with_groups`] and [`NodeGraph::is_mirrored`]: one
+    /// comparison per entry of a node's first column and one lookup per node edge); only a
+    /// refused pattern goes through [`CscRef::check_structurally_symmetric`], for the first
+    /// entry without its mirror.
     ///
+    /// The grouped pattern is symmetric exactly when (i) every node's pattern is made of whole
+    /// nodes (it holds all rows of a node or none) and (ii) the node adjacency is symmetric.
     /// If: take an entry (i, j), j in node g and i in node h. Column j's pattern is g's, which
     /// holds i, so all of h by (i); then h = g, or h is g's neighbour and by (ii) g is h's,
     /// so h's pattern holds a row of g and by (i) all of g, j among them: column i holds j.
     /// Only if: with a symmetric pattern row i's pattern is column i's, the same for all
     /// columns of h, so a column holds all rows of h or none (i); (ii) follows.
-    fn groups_a_symmetric_pattern(&self, a: CscRef<'_>, group: &[usize]) -> bool {
-        let whole_nodes = |g: usize| {
-            let rows = a.col(self.starts[g]).0;
-            let mut p = 0;
-            while p < rows.len() {
-                let h = group[rows[p]];
-                let (first, end) = (self.starts[h], self.starts[h + 1]);
-                let run = &rows[p..(p + end - first).min(rows.len())];
-                if run.len() != end - first || run[0] != first || run[run.len() - 1] != end - 1 {
-                    return false;
-                }
-                p += run.len();
-            }
-            true
-        };
-        let mirrored = |g: usize| {
-            self.neighbours(g)
-                .iter()
-                .all(|&h| self.neighbours(h).binary_search(&g).is_ok())
-        };
+    pub fn of(a: CscRef<'_>) -> Result<Self, SolverError> {
+        if a.nrows() != a.ncols() {
+            a.check_structurally_symmetric()?;
+        }
+        let (graph, whole_nodes) = Self::with_groups(a);
+        if !(whole_nodes && graph.is_mirrored()) {
+            a.check_structurally_symmetric()?;
+        }
+        Ok(graph)
+    }
+
+    /// Whether the node adjacency is symmetric: every node is in the list of each of its
+    /// neighbours.
+    fn is_mirrored(&self) -> bool {
         (0..self.nodes())
             .into_par_iter()
             .with_min_len(1024)
-            .all(|g| whole_nodes(g) && mirrored(g))
+            .all(|g| {
+                self.neighbours(g)
+                    .iter()
+                    .all(|&h| self.neighbours(h).binary_search(&g).is_ok())
+            })
     }
 
     /// [`NodeGraph::of`] for a pattern the caller has checked with
@@ -123,9 +109,11 @@ impl NodeGraph {
         Self::with_groups(a).0
     }
 
-    /// The graph of `a`'s pattern as [`NodeGraph::of_checked`] makes it, and the node of each
-    /// column. The columns' comparisons and the nodes' lists are made on the threads.
-    fn with_groups(a: CscRef<'_>) -> (Self, Vec<usize>) {
+    /// The graph of `a`'s pattern as [`NodeGraph::of_checked`] makes it, and whether every
+    /// node's pattern is made of whole nodes (each run of a node's rows in its first column
+    /// holds all of them). The columns' comparisons
+    /// and the nodes' lists are made on the threads.
+    fn with_groups(a: CscRef<'_>) -> (Self, bool) {
         let n = a.ncols();
         let opens: Vec<bool> = (0..n)
             .into_par_iter()
@@ -143,34 +131,45 @@ impl NodeGraph {
         let m = starts.len();
         starts.push(n);
         // Node g's neighbours: the nodes of its first column's rows (ascending), but g.
-        let lists: Vec<(Vec<usize>, Vec<usize>)> = starts[..m]
+        let weight = |h: usize| starts[h + 1] - starts[h];
+        let lists: Vec<(Vec<usize>, Vec<usize>, bool)> = starts[..m]
             .par_chunks(NODES_PER_TASK)
             .enumerate()
             .map(|(c, firsts)| {
                 let (mut ends, mut adj) = (Vec::with_capacity(firsts.len()), Vec::new());
+                let mut whole = true;
                 for (g, &first) in (c * NODES_PER_TASK..).zip(firsts) {
-                    let mut last = usize::MAX;
+                    // The rows strictly ascend, so each node's rows are one run, all of
+                    // the node when the run is as long as the node is wide.
+                    let (mut last, mut run) = (usize::MAX, 0);
                     for &r in a.col(first).0 {
                         let h = group[r];
-                        if h != g && h != last {
-                            adj.push(h);
-                            last = h;
+                        if h != last {
+                            whole &= last == usize::MAX || run == weight(last);
+                            if h != g {
+                                adj.push(h);
+                            }
+                            (last, run) = (h, 0);
                         }
+                        run += 1;
                     }
+                    whole &= last == usize::MAX || run == weight(last);
                     ends.push(adj.len());
                 }
-                (ends, adj)
+                (ends, adj, whole)
             })
             .collect();
         let mut xadj = Vec::with_capacity(m + 1);
         let mut adj = Vec::with_capacity(lists.iter().map(|l| l.1.len()).sum());
+        let mut whole_nodes = true;
         xadj.push(0);
-        for (ends, part) in lists {
+        for (ends, part, whole) in lists {
             let offset = adj.len();
             xadj.extend(ends.iter().map(|&e| offset + e));
             adj.extend(part);
+            whole_nodes &= whole;
         }
-        (NodeGraph { starts, xadj, adj }, group)
+        (NodeGraph { starts, xadj, adj }, whole_nodes)
     }
 
     /// Number of nodes.
@@ -768,8 +767,8 @@ mod tests {
         let a = scattered(40);
         let r = a.as_ref();
         let symmetric = |b: CscRef<'_>| {
-            let (g, group) = NodeGraph::with_groups(b);
-            g.groups_a_symmetric_pattern(b, &group)
+            let (g, whole_nodes) = NodeGraph::with_groups(b);
+            whole_nodes && g.is_mirrored()
         };
         assert!(symmetric(r));
         let position = |i: usize, j: usize| {
