@@ -66,7 +66,7 @@ pub struct FillEstimate {
 impl NodeGraph {
     /// The node graph of `a`, whose pattern must be square and symmetric (checked: AMD and
     /// METIS hang or return nonsense on one triangle). The check runs on the nodes while
-    /// they are made (see [`NodeGraph::with_groups`] and [`NodeGraph::is_mirrored`]: one
+    /// they are made (see `NodeGraph::with_groups` and `NodeGraph::is_mirrored`: one
     /// comparison per entry of a node's first column and one lookup per node edge); only a
     /// refused pattern goes through [`CscRef::check_structurally_symmetric`], for the first
     /// entry without its mirror.
