@@ -286,14 +286,13 @@ impl FaerCholesky {
         perm: &Permutation,
         order: Option<&NodeOrder>,
     ) -> Result<Symbolic, SolverError> {
-        if let Some(o) = order {
+        if let Some(o) = order.filter(|o| supernodal_fill(&o.fill)) {
             let large = o.fill.nnz_l >= self.own_supernodes_from;
-            if self.variant == CholeskyVariant::Llt && large && supernodal_fill(&o.fill) {
-                return Supernodes::of_node_tree(&o.graph, &o.tree).map(Symbolic::Nodes);
-            }
-            if let Some(sn) = supernodal_of_node_tree(&o.graph, &o.tree)? {
-                return Ok(Symbolic::Supernodal(sn));
-            }
+            return if self.variant == CholeskyVariant::Llt && large {
+                Supernodes::of_node_tree(&o.graph, &o.tree).map(Symbolic::Nodes)
+            } else {
+                supernodal_of_node_tree(&o.graph, &o.tree).map(Symbolic::Supernodal)
+            };
         }
         // faer reads the lower triangle of the pattern it is given (its entries with row ≥
         // column), so A's own pattern serves.

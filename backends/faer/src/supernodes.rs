@@ -126,7 +126,8 @@ impl Supernodes {
     /// as faer's supernodal analysis with its default relaxation makes them. O(nodes + node
     /// edges + stored row indices).
     pub(crate) fn of_node_tree(graph: &NodeGraph, tree: &NodeTree) -> Result<Self, SolverError> {
-        let width: Vec<usize> = tree.nodes().iter().map(|&g| graph.weight(g)).collect();
+        let starts = tree.column_starts(graph);
+        let width: Vec<usize> = starts.windows(2).map(|w| w[1] - w[0]).collect();
         let (parent, below) = (tree.parents(), tree.below());
         let m = width.len();
         if m == 0 {
@@ -143,7 +144,6 @@ impl Supernodes {
         }
         let fundamental = fundamental_supernodes(&width, parent, below);
         let relaxed = relaxed_supernodes(&fundamental, &width, parent, below);
-        let starts = tree.column_starts(graph);
         let mut s = Supernodes::shaped(&relaxed, &starts, below);
         s.row_idx = rows(graph, tree, &relaxed, &starts, &s.col_ptr_for_row_idx)?;
         Ok(s)

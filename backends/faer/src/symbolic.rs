@@ -112,29 +112,22 @@ impl Symbolic {
 const SUPERNODAL_FLOPS_PER_ENTRY: f64 = 40.0;
 
 /// Whether faer makes a supernodal factor of this fill: its flop count Σ c + c(c + 1)/2 is
-/// Σ c²/2 + 3/2 Σ c over the column counts c.
+/// Σ c²/2 + 3/2 Σ c over the column counts c (integer sums, exact in f64 far beyond L).
 pub(crate) fn supernodal_fill(fill: &FillEstimate) -> bool {
     let entries = fill.nnz_l as f64;
     fill.nnz_l > 0 && (fill.flops / 2.0 + 1.5 * entries) / entries > SUPERNODAL_FLOPS_PER_ENTRY
 }
 
 /// faer's supernodal structure of the matrix permuted by `tree`'s order (in that order), from
-/// the node tree; `None` where faer would make a simplicial factor (then its own analysis
-/// serves). Same supernodes, rows and value layout as `factorize_symbolic_cholesky` with that
-/// permutation (tested exactly).
+/// the node tree, for an order whose fill faer makes supernodal ([`supernodal_fill`]). Same
+/// supernodes, rows and value layout as `factorize_symbolic_cholesky` with that permutation
+/// (tested exactly).
 pub(crate) fn supernodal_of_node_tree(
     graph: &NodeGraph,
     tree: &NodeTree,
-) -> Result<Option<SymbolicSupernodalCholesky<usize>>, SolverError> {
+) -> Result<SymbolicSupernodalCholesky<usize>, SolverError> {
     let scalar = tree.scalar_tree(graph);
     let n = scalar.counts.len();
-    let (nnz, flops) = scalar.counts.iter().fold((0.0, 0.0), |(e, f), &c| {
-        let c = c as f64;
-        (e + c, f + c + c * (c + 1.0) / 2.0)
-    });
-    if n == 0 || !(flops / nnz > SUPERNODAL_FLOPS_PER_ENTRY) {
-        return Ok(None);
-    }
     // faer's supernodal step trusts its tree: check what `from_inner` asks (a parent after
     // its child, in range, or −1 at a root) in O(n).
     let valid = scalar
@@ -163,7 +156,6 @@ pub(crate) fn supernodal_of_node_tree(
         MemStack::new(&mut buf),
         SymbolicSupernodalParams::default(),
     )
-    .map(Some)
     .map_err(|e| internal(&format!("supernodal symbolic factorization failed: {e:?}")))
 }
 
@@ -221,7 +213,8 @@ mod tests {
             for o in orderings {
                 let ordered = g.ordered(&o).unwrap();
                 let p = &ordered.permutation;
-                let ours = supernodal_of_node_tree(&g, &ordered.tree).unwrap();
+                let ours = supernodal_fill(&ordered.fill)
+                    .then(|| supernodal_of_node_tree(&g, &ordered.tree).unwrap());
                 let theirs = faer_supernodal(a, &p.fwd, &p.inv);
                 let (Some(ours), Some(theirs)) = (ours, &theirs) else {
                     assert!(theirs.is_none(), "{name}, {}: faer is supernodal", o.name());
