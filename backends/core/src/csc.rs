@@ -428,24 +428,32 @@ impl<'a> CscRef<'a> {
         if k == 0 {
             return (0.0, states);
         }
+        // Each group of up to eight columns of X interleaved and padded to eight (row r's
+        // values side by side): an entry's products are one vector operation, where the
+        // columns apart took a load each. The seven residuals of L's cell problems: 0.108–0.113
+        // → 0.078–0.087 s, the interleaved copy included.
+        let groups: Vec<Vec<[f64; GROUP]>> = (0..k)
+            .step_by(GROUP)
+            .map(|c0| {
+                let m = GROUP.min(k - c0);
+                let row = |r: usize| {
+                    std::array::from_fn(|c| if c < m { x[(c0 + c) * n + r] } else { 0.0 })
+                };
+                (0..n).into_par_iter().map(row).collect()
+            })
+            .collect();
         let folded: Vec<(f64, T)> = states
             .into_par_iter()
             .enumerate()
             .map(|(chunk, mut state)| {
                 let rows_of_chunk = chunk * PRODUCT_CHUNK..n.min((chunk + 1) * PRODUCT_CHUNK);
                 let mut norm = 0.0f64;
-                for c0 in (0..k).step_by(GROUP) {
+                for (g, c0) in (0..k).step_by(GROUP).enumerate() {
                     let m = GROUP.min(k - c0);
-                    let xs: [&[f64]; GROUP] =
-                        std::array::from_fn(|c| &x[(c0 + c.min(m - 1)) * n..][..n]);
+                    let xg = &groups[g];
                     for i in rows_of_chunk.clone() {
                         let (rows, vals) = self.col(i);
-                        let mut sums = [0.0; GROUP];
-                        for (&r, &v) in rows.iter().zip(vals) {
-                            for (s, xc) in sums.iter_mut().zip(&xs).take(m) {
-                                *s += v * xc[r];
-                            }
-                        }
+                        let sums = row_products(rows, vals, xg);
                         visit(&mut state, i, c0, &sums[..m]);
                         if c0 == 0 {
                             norm = norm.max(vals.iter().map(|v| v.abs()).sum());
@@ -469,6 +477,42 @@ impl<'a> CscRef<'a> {
             values: self.values.to_vec(),
         }
     }
+}
+
+/// Σ_k v_k X[r_k] over a column's entries (`rows`, `vals`) for eight interleaved columns,
+/// summed in entry order (the same sums as one column at a time), with the machine's widest
+/// vectors (checked at run time).
+fn row_products(rows: &[usize], vals: &[f64], x: &[[f64; 8]]) -> [f64; 8] {
+    #[inline(always)]
+    fn sums(rows: &[usize], vals: &[f64], x: &[[f64; 8]]) -> [f64; 8] {
+        let mut s = [0.0; 8];
+        for (&r, &v) in rows.iter().zip(vals) {
+            for (sc, xc) in s.iter_mut().zip(&x[r]) {
+                *sc += v * xc;
+            }
+        }
+        s
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx512f")]
+        unsafe fn wide(rows: &[usize], vals: &[f64], x: &[[f64; 8]]) -> [f64; 8] {
+            sums(rows, vals, x)
+        }
+        #[target_feature(enable = "avx")]
+        unsafe fn avx(rows: &[usize], vals: &[f64], x: &[[f64; 8]]) -> [f64; 8] {
+            sums(rows, vals, x)
+        }
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F, checked above.
+            return unsafe { wide(rows, vals, x) };
+        }
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX, checked above.
+            return unsafe { avx(rows, vals, x) };
+        }
+    }
+    sums(rows, vals, x)
 }
 
 impl CscMatrix {
