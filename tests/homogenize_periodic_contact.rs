@@ -141,3 +141,46 @@ fn the_incremental_curve_across_the_boundary_is_the_elastic_one() {
         }
     }
 }
+
+/// The periodic discretization's shortcut: a block of node images is the identity (T = I on
+/// the nodes themselves, what `contact_pair` and the Θ load then skip forming) exactly when
+/// `block_of_images` gives the nodes back with T = I. Both cells hold contacts and elements of
+/// both kinds (slaves on the faces, images across the cut), and a repeated node is not one.
+#[test]
+fn a_block_is_the_identity_exactly_when_its_images_map_onto_themselves() {
+    use fibercell::homogenize::PeriodicSystem;
+    use nalgebra::DMatrix;
+    for x0 in [0.0, seam()] {
+        let model = Model::from_description(&cell(x0, 1.0)).unwrap();
+        let sys = PeriodicSystem::new(&model).unwrap();
+        let disc = &sys.discretization;
+        let set = ContactSet::build_with(&model, Some(&sys.periodicity)).unwrap();
+        let contacts = set
+            .pairs
+            .iter()
+            .map(|p| (p.jump.nodes.clone(), p.jump.shifts.clone()));
+        let elements = model
+            .elements()
+            .iter()
+            .map(|e| (e.nodes.to_vec(), vec![[0, 0]; 2]));
+        let repeated = (vec![0, 0], vec![[0, 0]; 2]);
+        let mut seen = [0usize; 2];
+        for (nodes, shifts) in contacts.chain(elements).chain([repeated]) {
+            let (gnodes, t) = disc.block_of_images(&nodes, &shifts);
+            let identity = gnodes == nodes && t == DMatrix::identity(t.nrows(), t.ncols());
+            assert_eq!(
+                disc.is_identity_block(&nodes, &shifts),
+                identity,
+                "nodes {nodes:?}, shifts {shifts:?}"
+            );
+            seen[usize::from(identity)] += 1;
+        }
+        assert!(seen[0] > 1 && seen[1] > 0, "x0 {x0}: {seen:?} blocks");
+        if x0 != 0.0 {
+            assert!(set
+                .pairs
+                .iter()
+                .any(|p| p.jump.shifts.iter().any(|s| *s != [0, 0])));
+        }
+    }
+}

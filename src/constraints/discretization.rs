@@ -228,6 +228,18 @@ impl Discretization {
         (gnodes, t)
     }
 
+    /// Whether the block of these node images is the identity: no node is a slave or
+    /// repeated, no image shifted — then the generalized nodes are `nodes` themselves and T = I,
+    /// with no need to form them ([`Discretization::block_of_images`] gives the same).
+    pub fn is_identity_block(&self, nodes: &[usize], shifts: &[[i32; 2]]) -> bool {
+        shifts.iter().all(|s| *s == [0, 0])
+            && nodes.iter().all(|&n| self.maps[n].is_none())
+            && nodes
+                .iter()
+                .enumerate()
+                .all(|(k, n)| !nodes[..k].contains(n))
+    }
+
     /// Whether every node is its own generalized node (no periodic maps).
     pub fn is_identity(&self) -> bool {
         self.maps.iter().all(|m| m.is_none())
@@ -263,8 +275,7 @@ impl Discretization {
 
     /// A contact pair with its jumps moved onto generalized nodes (B T and R T).
     pub fn contact_pair(&self, pair: &ContactPair) -> ContactPair {
-        let images = pair.jump.shifts.iter().any(|s| *s != [0, 0]);
-        if self.is_identity() && !images {
+        if self.is_identity_block(&pair.jump.nodes, &pair.jump.shifts) {
             return pair.clone();
         }
         let k = pair.jump.nodes.len();

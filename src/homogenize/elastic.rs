@@ -295,8 +295,19 @@ fn theta_load(model: &Model, sys: &PeriodicSystem, column: &mut [f64]) -> ThetaL
     let (mut driver_load, mut virial) = ([0.0; 6], [0.0; 6]);
     for (e, shift, f) in &load.elements {
         let nodes = model.elements()[*e].nodes;
-        let (gnodes, t) = disc.block_of_images(&nodes, &[*shift, *shift]);
-        let fg = t.transpose() * DMatrix::from_column_slice(12, 1, f.as_slice());
+        let shifts = [*shift, *shift];
+        // Tᵀ f on the generalized nodes; most elements are their own (T = I).
+        let moved;
+        let (gnodes, fg): (&[usize], &[f64]) = if disc.is_identity_block(&nodes, &shifts) {
+            (&nodes, f.as_slice())
+        } else {
+            let (gnodes, t) = disc.block_of_images(&nodes, &shifts);
+            moved = (
+                gnodes,
+                t.transpose() * DMatrix::from_column_slice(12, 1, f.as_slice()),
+            );
+            (&moved.0, moved.1.as_slice())
+        };
         for (c, &gn) in gnodes.iter().enumerate() {
             for d in 0..6 {
                 if gn == driver {
