@@ -13,6 +13,7 @@ use crate::solve::{check_backward_error, SolveOptions};
 use crate::Error;
 use fibercell_solver::{solve_checked, solve_checked_into, CscRef, LinearSolver, SolverError};
 use nalgebra::DMatrix;
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Effective properties of a cell.
@@ -394,21 +395,31 @@ pub fn homogenize_elastic(model: &Model, options: &SolveOptions) -> Result<Homog
             .sum();
         (reaction - load.driver_load[k] + load.virial[k]) / area
     });
+    // ABD beside the seven solutions expanded to every node (each its own pass; on L 0.06 s
+    // one after another, 0.03 s side by side).
+    let (abd, mut expanded) = rayon::join(
+        || abd_of(&vals.couplings, &x, n, area),
+        || {
+            (0..7)
+                .into_par_iter()
+                .map(|k| {
+                    let mut e = [0.0; 6];
+                    if k < 6 {
+                        e[k] = 1.0;
+                    }
+                    sys.expand(&x[k * n..(k + 1) * n], &e)
+                })
+                .collect::<Vec<_>>()
+        },
+    );
     let pressure = PressureResponse {
         b_hom,
         coverage: load.coverage,
         pixel: load.pixel,
-        displacements: sys.expand(theta, &[0.0; 6]),
+        displacements: expanded.pop().unwrap_or_default(),
     };
-    let abd = abd_of(&vals.couplings, &x, n, area);
     let asym = abd_asymmetry(&abd);
-    let cases = (0..6)
-        .map(|k| {
-            let mut e = [0.0; 6];
-            e[k] = 1.0;
-            sys.expand(&x[k * n..(k + 1) * n], &e)
-        })
-        .collect();
+    let cases = expanded;
     timings.post = lap();
     timings.total = start.elapsed().as_secs_f64();
     Ok(Homogenized {
