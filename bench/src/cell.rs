@@ -15,7 +15,7 @@ use fibercell::model::{FrictionSpec, Model};
 use fibercell::solve::bench_internals::{ContactChange, LowRankCorrection, SparseColumn};
 use fibercell::solve::{IncrementalOptions, SolveOptions, SolverConfig, SolverKind};
 use fibercell::Error;
-use fibercell_solver::{backward_error, pcg_with_factor, CscRef, FillOrdering};
+use fibercell_solver::{backward_error, median, pcg_with_factor, CscRef, FillOrdering};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -25,12 +25,6 @@ const SHORT_STAGE_REPEATS: usize = 15;
 /// Fewest runs of the first and next low-rank solves after switches (fractions of a second on
 /// L, with a spread of ±20 % between runs on the VMs measured).
 const LOW_RANK_REPEATS: usize = 7;
-
-/// Median of non-empty `times` (the upper one of an even count); 0 when empty.
-fn median(mut times: Vec<f64>) -> f64 {
-    times.sort_by(f64::total_cmp);
-    times.get(times.len() / 2).copied().unwrap_or(0.0)
-}
 
 /// Median of `repeats` timings of `f` (seconds), with the last result.
 fn median_of<T>(

@@ -3,7 +3,7 @@
 
 use super::SolverConfig;
 use crate::Error;
-use fibercell_solver::{solve_checked, CscRef, SolverError};
+use fibercell_solver::{median, solve_checked, CscRef, SolverError};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -117,12 +117,6 @@ pub fn solve_matrix(
             error_against_ones,
         },
     ))
-}
-
-/// The median of `times` (the upper one of an even count).
-fn median(mut times: Vec<f64>) -> f64 {
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
 }
 
 /// The largest backward error a [`MatrixSolver`] solve accepts.

@@ -27,6 +27,7 @@ mod factor_pcg;
 mod forward;
 mod lower;
 mod matrix_market;
+mod median;
 mod ordering;
 mod residual;
 mod solver;
@@ -39,6 +40,7 @@ pub use factor_pcg::{pcg_with_factor, FactorPcg};
 pub use forward::{ForwardBlock, ForwardColumns};
 pub use lower::{permuted_diagonal_scale, LowerTriangle};
 pub use matrix_market::{read_matrix_market, read_matrix_market_dense};
+pub use median::median;
 pub use ordering::{
     compute_ordering, FillEstimate, FillOrdering, NodeGraph, NodeTree, OrderedNodes, Permutation,
     ReachPattern, ScalarTree,

@@ -22,16 +22,12 @@ use fibercell_c::cell::{
     fc_cell_free, fc_cell_new, fc_cell_state_free, fc_cell_state_new, fc_cell_update,
 };
 use fibercell_c::{FcCellResponse, FcStatus};
+use fibercell_solver::median;
 use rayon::prelude::*;
 use std::time::Instant;
 
 fn load(path: &str) -> Result<Model, Box<dyn std::error::Error>> {
     Ok(fibercell::io::load_model(std::path::Path::new(path))?)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// Resident memory of the process now (bytes), from /proc/self/statm, after the allocator
