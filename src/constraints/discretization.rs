@@ -173,10 +173,19 @@ impl Discretization {
     /// slave: the element acts on its own nodes' DOFs) — the common case, which then needs no
     /// Tᵀ K T.
     pub fn non_identity_block(&self, nodes: &[usize]) -> Option<(Vec<usize>, DMatrix<f64>)> {
-        if nodes.iter().all(|&n| self.maps[n].is_none()) {
+        if self.are_own_nodes(nodes) {
             return None;
         }
         Some(self.block(nodes))
+    }
+
+    /// Whether `nodes` are their own generalized nodes: none a slave, none repeated (T = I).
+    fn are_own_nodes(&self, nodes: &[usize]) -> bool {
+        nodes.iter().all(|&n| self.maps[n].is_none())
+            && nodes
+                .iter()
+                .enumerate()
+                .all(|(k, n)| !nodes[..k].contains(n))
     }
 
     /// As [`Discretization::block`] for periodic images of the nodes, shifted by `shifts`
@@ -232,12 +241,7 @@ impl Discretization {
     /// repeated, no image shifted — then the generalized nodes are `nodes` themselves and T = I,
     /// with no need to form them ([`Discretization::block_of_images`] gives the same).
     pub fn is_identity_block(&self, nodes: &[usize], shifts: &[[i32; 2]]) -> bool {
-        shifts.iter().all(|s| *s == [0, 0])
-            && nodes.iter().all(|&n| self.maps[n].is_none())
-            && nodes
-                .iter()
-                .enumerate()
-                .all(|(k, n)| !nodes[..k].contains(n))
+        shifts.iter().all(|s| *s == [0, 0]) && self.are_own_nodes(nodes)
     }
 
     /// Whether every node is its own generalized node (no periodic maps).

@@ -85,7 +85,6 @@ fn check_structure(
         }
         None
     };
-    const COLUMNS_PER_TASK: usize = 1 << 14;
     let first = if nnz >= PARALLEL_CHECK_ENTRIES {
         (0..ncols)
             .into_par_iter()
@@ -97,8 +96,10 @@ fn check_structure(
     first.map_or(Ok(()), bad)
 }
 
-/// Patterns with at least this many entries are checked on all threads.
+/// Patterns with at least this many entries are checked on all threads, in tasks of at least
+/// [`COLUMNS_PER_TASK`] columns.
 const PARALLEL_CHECK_ENTRIES: usize = 1 << 20;
+const COLUMNS_PER_TASK: usize = 1 << 14;
 
 impl<'a> CscRef<'a> {
     /// Checks the arrays (sizes, bounds, sorted unique rows) and wraps them.
