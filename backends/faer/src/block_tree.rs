@@ -99,13 +99,19 @@ impl BlockTree {
             block_of[b.begin..b.begin + b.width].fill(s);
         }
         let rows = row_idx(symbolic);
+        // A block's parent holds its first row below the diagonal block: a supernode's rows
+        // ascend, a simplicial column's are searched.
+        let ascending = matches!(symbolic.raw(), Raw::Supernodal(_));
         let parent = shapes
             .iter()
             .map(|b| {
-                rows[b.pattern.clone()]
-                    .iter()
-                    .min()
-                    .map_or(NONE, |&r| block_of[r])
+                let pattern = &rows[b.pattern.clone()];
+                let first = if ascending {
+                    pattern.first()
+                } else {
+                    pattern.iter().min()
+                };
+                first.map_or(NONE, |&r| block_of[r])
             })
             .collect();
         BlockTree {

@@ -70,17 +70,14 @@ pub struct FaerCholesky {
 struct Analysis {
     n: usize,
     fingerprint: PatternFingerprint,
-    /// The permutation faer factorizes with (`fwd[new] = old`).
+    /// The permutation of the factor (`fwd[new] = old`, `inv[old] = new`): faer factorizes
+    /// with it, and a solve reads x[new] = b[fwd[new]].
     perm: Permutation,
     symbolic: Symbolic,
     /// The block tree of L for sparse forward solves.
     tree: BlockTree,
     /// Its blocks per thread for solves with one right-hand side.
     schedule: SolveSchedule,
-    /// The permutation faer solves with, x[new] = b[fwd[new]].
-    factor_fwd: Vec<usize>,
-    /// Its inverse, `inv[old] = new`.
-    factor_inv: Vec<usize>,
     /// Which numeric kernel factorizes, with what it reads.
     kernel: Kernel,
 }
@@ -148,7 +145,7 @@ fn factor_view<'a>(an: &'a Analysis, f: &'a Factor) -> FactorView<'a> {
     FactorView {
         symbolic: &an.symbolic,
         values: &f.l_values,
-        inv: &an.factor_inv,
+        inv: &an.perm.inv,
         scale: &f.scale,
     }
 }
@@ -232,7 +229,7 @@ impl FaerCholesky {
         <dyn LinearSolver>::check_rhs(an.n, x, 1)?;
         let parallel = an.schedule.is_parallel();
         y.resize(an.n, 0.0);
-        permute::into_factor_order(x, &f.scale, &an.factor_fwd, &mut y, parallel);
+        permute::into_factor_order(x, &f.scale, &an.perm.fwd, &mut y, parallel);
         let out = forward(an, f, &mut y);
         if out.is_ok() {
             permute::copy(&y, x, parallel);
@@ -350,11 +347,11 @@ fn factorize_with_tasks(
             message: "a task plan without a supernodal factor (an internal error)".into(),
         });
     };
-    let scale = permuted_diagonal_scale(a, &an.factor_fwd, &mut f.scale)?;
+    let scale = permuted_diagonal_scale(a, &an.perm.fwd, &mut f.scale)?;
     let scaled = ScaledMatrix {
         a,
-        fwd: &an.factor_fwd,
-        inv: &an.factor_inv,
+        fwd: &an.perm.fwd,
+        inv: &an.perm.inv,
         scale: &scale,
     };
     supernodal_llt::factorize_llt(
@@ -365,7 +362,7 @@ fn factorize_with_tasks(
         plan,
         threads(par),
     )
-    .map_err(|p| pivot_error(an.factor_fwd[p.index], p.value))?;
+    .map_err(|p| pivot_error(an.perm.fwd[p.index], p.value))?;
     Ok(f)
 }
 
@@ -456,14 +453,15 @@ impl LinearSolver for FaerCholesky {
             flops: Some(flops),
             ordering: name,
         };
-        let (factor_fwd, factor_inv) = match &symbolic {
-            Symbolic::Faer(s) => match s.perm() {
-                Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
-                None => ((0..n).collect(), (0..n).collect()),
-            },
-            Symbolic::Supernodal(_) | Symbolic::Nodes(_) => (perm.fwd.clone(), perm.inv.clone()),
-        };
-        // The block tree and its solve schedule beside the task plan (on L 15 ms and 22 ms).
+        // faer's own symbolic factor keeps the permutation it was given (or none for the
+        // identity), so the factor's order is `perm` for every kind.
+        if let Symbolic::Faer(s) = &symbolic {
+            debug_assert!(match s.perm() {
+                Some(p) => p.arrays().0 == perm.fwd.as_slice(),
+                None => perm.fwd.iter().enumerate().all(|(new, &old)| new == old),
+            });
+        }
+        // The block tree and its solve schedule beside the task plan (on L 9–16 ms and 17–22 ms).
         let threads = threads(self.par);
         let ((tree, schedule), plan) = rayon::join(
             || {
@@ -478,7 +476,6 @@ impl LinearSolver for FaerCholesky {
                 _ => None,
             },
         );
-        debug_assert_eq!(factor_inv, perm.inv);
         if plan.is_none() && symbolic.is_ours() {
             // Only past 2³² columns, which no factor in memory reaches.
             return Err(internal("no task plan for this crate's supernodes"));
@@ -494,8 +491,6 @@ impl LinearSolver for FaerCholesky {
             perm,
             schedule,
             tree,
-            factor_fwd,
-            factor_inv,
             symbolic,
             kernel,
         }));
@@ -567,7 +562,7 @@ impl LinearSolver for FaerCholesky {
         };
         let supernodal = an.symbolic.faer_supernodal();
         if supernodal.is_some() {
-            lower.scaled_permuted_values(a, &an.factor_fwd, &mut f.scale, &mut ws.lower_values)?;
+            lower.scaled_permuted_values(a, &an.perm.fwd, &mut f.scale, &mut ws.lower_values)?;
         } else {
             lower.scaled_values(a, &mut f.scale, &mut ws.lower_values)?;
         }
@@ -699,9 +694,9 @@ impl LinearSolver for FaerCholesky {
             // cache faer's kernels are faster).
             let mut x = std::mem::take(&mut self.work);
             x.resize(n, 0.0);
-            permute::into_factor_order(rhs, &f.scale, &an.factor_fwd, &mut x, true);
+            permute::into_factor_order(rhs, &f.scale, &an.perm.fwd, &mut x, true);
             block_solve(&an.tree, &an.schedule, &an.symbolic, &f.l_values, &mut x);
-            permute::from_factor_order(&x, &f.scale, &an.factor_inv, rhs, true);
+            permute::from_factor_order(&x, &f.scale, &an.perm.inv, rhs, true);
             self.work = x;
             return Ok(SolveInfo::default());
         }
@@ -710,7 +705,7 @@ impl LinearSolver for FaerCholesky {
             // each block at once (faer's solve reads the factor once per column group). The
             // buffer is not kept: shared solvers of many material points would each hold one.
             let mut x = vec![0.0; n * nrhs];
-            permute::many_into_factor_order(rhs, nrhs, &f.scale, &an.factor_fwd, &mut x);
+            permute::many_into_factor_order(rhs, nrhs, &f.scale, &an.perm.fwd, &mut x);
             let blocks = FactorBlocks {
                 tree: &an.tree,
                 schedule: &an.schedule,
@@ -718,7 +713,7 @@ impl LinearSolver for FaerCholesky {
                 values: &f.l_values,
             };
             solve_many_in_place(blocks, &mut x, nrhs);
-            permute::many_from_factor_order(&x, nrhs, &f.scale, &an.factor_inv, rhs);
+            permute::many_from_factor_order(&x, nrhs, &f.scale, &an.perm.inv, rhs);
             return Ok(SolveInfo::default());
         }
         // Several right-hand sides: column groups solved side by side, one per thread (faer's
@@ -745,7 +740,7 @@ impl LinearSolver for FaerCholesky {
                 let mut x = vec![0.0; n * nrhs];
                 let parallel = threads > 1;
                 for (b, y) in rhs.chunks(n).zip(x.chunks_mut(n)) {
-                    permute::into_factor_order(b, &f.scale, &an.factor_fwd, y, parallel);
+                    permute::into_factor_order(b, &f.scale, &an.perm.fwd, y, parallel);
                 }
                 let values = &f.l_values[..];
                 solve_groups(
@@ -761,7 +756,7 @@ impl LinearSolver for FaerCholesky {
                     },
                 )?;
                 for (y, b) in x.chunks(n).zip(rhs.chunks_mut(n)) {
-                    permute::from_factor_order(y, &f.scale, &an.factor_inv, b, parallel);
+                    permute::from_factor_order(y, &f.scale, &an.perm.inv, b, parallel);
                 }
             }
             None => {
@@ -808,7 +803,7 @@ impl LinearSolver for FaerCholesky {
         let parallel = an.schedule.is_parallel();
         backward_in_place(&an.tree, &an.schedule, &an.symbolic, &f.l_values, y);
         x.resize(an.n, 0.0);
-        permute::from_factor_order(y, &f.scale, &an.factor_inv, &mut x, parallel);
+        permute::from_factor_order(y, &f.scale, &an.perm.inv, &mut x, parallel);
         permute::copy(&x, y, parallel);
         self.work = x;
         Ok(())

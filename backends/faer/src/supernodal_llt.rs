@@ -136,38 +136,39 @@ impl SupernodalPlan {
     }
 }
 
-/// The supernode of every column.
-fn block_of_columns(sym: Symbolic<'_>) -> Vec<usize> {
+/// The supernode of every column, in 32 bits (the plan checked that the columns fit): half
+/// the pages and cache lines of `usize`, read once per row of every supernode's pattern.
+fn block_of_columns(sym: Symbolic<'_>) -> Vec<u32> {
     let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
-    let mut block_of = vec![0usize; sym.nrows()];
+    let mut block_of = vec![0u32; sym.nrows()];
     for s in 0..sym.n_supernodes() {
-        block_of[begin[s]..end[s]].fill(s);
+        block_of[begin[s]..end[s]].fill(s as u32);
     }
     block_of
 }
 
 /// Each supernode's parent (the supernode of its first off-diagonal row) and own work
 /// Σ c_j² over its columns.
-fn tree(sym: Symbolic<'_>, block_of: &[usize]) -> (Vec<usize>, Vec<f64>) {
+fn tree(sym: Symbolic<'_>, block_of: &[u32]) -> (Vec<usize>, Vec<f64>) {
     (0..sym.n_supernodes())
         .map(|s| {
             let pattern = sym.pattern(s);
             let width = sym.supernode_end()[s] - sym.supernode_begin()[s];
             let rows = (width + pattern.len()) as f64;
             let own: f64 = (0..width).map(|c| (rows - c as f64).powi(2)).sum();
-            (pattern.first().map_or(NONE, |&r| block_of[r]), own)
+            (pattern.first().map_or(NONE, |&r| block_of[r] as usize), own)
         })
         .unzip()
 }
 
 /// For every supernode s, the descendants d with a row in s's columns (ascending), in CSR
 /// form: the supernodes that d's pattern touches.
-fn updaters(sym: Symbolic<'_>, block_of: &[usize]) -> (Vec<usize>, Vec<u32>) {
+fn updaters(sym: Symbolic<'_>, block_of: &[u32]) -> (Vec<usize>, Vec<u32>) {
     let ns = sym.n_supernodes();
     let touched = |d: usize| {
         let mut last = NONE;
         sym.pattern(d).iter().filter_map(move |&r| {
-            let t = block_of[r];
+            let t = block_of[r] as usize;
             (t != last).then(|| {
                 last = t;
                 t
