@@ -12,7 +12,7 @@ use crate::block_tree::{BlockTree, FactorView};
 use crate::permute;
 use crate::pivots::{factor_diagonal, fill_and_flops, is_simplicial};
 use crate::prefault::{PrefaultedValues, PREFAULT_BYTES};
-use crate::supernodal_llt::{self, ScaledMatrix, SupernodalPlan, TaskSizes};
+use crate::supernodal_llt::{self, ScaledMatrix, ScratchPool, SupernodalPlan, TaskSizes};
 use crate::supernodes::Supernodes;
 use crate::symbolic::{internal, supernodal_fill, supernodal_of_node_tree, Raw, Symbolic};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -57,6 +57,8 @@ pub struct FaerCholesky {
     /// Workspace of the numeric factorization, sized once per analysis; kept between
     /// factorizations up to [`KEPT_WORKSPACE_BYTES`].
     workspace: Option<Workspace>,
+    /// The task-parallel LLᵀ's scratch, kept likewise.
+    task_scratch: ScratchPool,
     /// One right-hand side in the factor's order, kept between solves.
     work: Vec<f64>,
     /// Factors of at least this many bytes get a prefaulted first buffer.
@@ -162,6 +164,7 @@ impl FaerCholesky {
             analysis: None,
             factor: None,
             workspace: None,
+            task_scratch: ScratchPool::default(),
             work: Vec::new(),
             prefault_bytes: PREFAULT_BYTES,
             own_supernodes_from: OWN_SUPERNODES_FROM,
@@ -339,6 +342,7 @@ fn factorize_with_tasks(
     mut f: Factor,
     pivot_tolerance: f64,
     par: Par,
+    pool: &mut ScratchPool,
 ) -> Result<Factor, SolverError> {
     let Some(sn) = an.symbolic.supernodal() else {
         return Err(SolverError::Backend {
@@ -361,6 +365,7 @@ fn factorize_with_tasks(
         sn,
         plan,
         threads(par),
+        pool,
     )
     .map_err(|p| pivot_error(an.perm.fwd[p.index], p.value))?;
     Ok(f)
@@ -417,6 +422,7 @@ impl LinearSolver for FaerCholesky {
         self.factor = None;
         self.analysis = None;
         self.workspace = None;
+        self.task_scratch = ScratchPool::default();
         self.prefaulted = None;
         let n = a.ncols();
         // Every ordering's L holds A's lower triangle and the whole diagonal: at least
@@ -522,8 +528,13 @@ impl LinearSolver for FaerCholesky {
         let lower = match &an.kernel {
             Kernel::Faer(lower) => lower,
             Kernel::Tasks(plan) => {
-                let f = factorize_with_tasks(an, plan, a, f, self.pivot_tolerance, self.par)?;
-                self.factor = Some(Arc::new(f));
+                let mut pool = std::mem::take(&mut self.task_scratch);
+                let f =
+                    factorize_with_tasks(an, plan, a, f, self.pivot_tolerance, self.par, &mut pool);
+                if pool.bytes() <= KEPT_WORKSPACE_BYTES {
+                    self.task_scratch = pool;
+                }
+                self.factor = Some(Arc::new(f?));
                 return Ok(());
             }
         };
@@ -671,6 +682,7 @@ impl LinearSolver for FaerCholesky {
             analysis: self.analysis.clone(),
             factor: self.factor.clone(),
             workspace: None,
+            task_scratch: ScratchPool::default(),
             work: Vec::new(),
             prefault_bytes: self.prefault_bytes,
             own_supernodes_from: self.own_supernodes_from,
