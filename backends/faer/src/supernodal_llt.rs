@@ -287,8 +287,8 @@ struct Scratch {
     stack_dim: usize,
 }
 
-/// The scratch of a factorization's tasks, kept for the next factorization: allocated anew,
-/// L seed 1's (four of them, 50 MB: two rows' positions of 3.7 MB, product buffers up to
+/// The scratch of a factorization's tasks, kept for the next factorization. Made anew each
+/// time, L seed 1's four (50 MB: two position arrays of 3.7 MB, product buffers of up to
 /// 19 MB) faulted 3,700 fresh pages in every factorization.
 #[derive(Default)]
 pub(crate) struct ScratchPool(Vec<Scratch>);
