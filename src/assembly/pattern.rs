@@ -309,8 +309,6 @@ impl<'a> BlockSlots<'a> {
     }
 }
 
-/// `v` cut into consecutive pieces of the given lengths (which must add up to at most its
-/// length), for filling them on several threads.
 /// Each node's neighbours through the blocks (itself included), ascending and unique: node
 /// p's are `list[start[p]..start[p] + len[p]]`. One array filled in one pass, then sorted per
 /// node on all threads (a vector per node, grown block by block, took 40 ms on L's 155,781
@@ -370,6 +368,8 @@ impl NodeAdjacency {
     }
 }
 
+/// `v` cut into consecutive pieces of the given lengths (which must add up to at most its
+/// length), for filling them on several threads.
 fn split_by_lengths<T>(mut v: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
     let mut pieces = Vec::new();
     for len in lengths {

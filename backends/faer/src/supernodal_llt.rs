@@ -618,9 +618,8 @@ impl<'a> Context<'a> {
         let (range, d_width, d_rows, d_pattern) = self.shape(d);
         let begin = self.sym.supernode_begin()[s];
         // The rows of d in s's columns `cols`, and below them.
-        let p0 = d_pattern.partition_point(|&r| r < begin + cols.start);
+        let (p0, m) = rows_from(d_pattern, begin + cols.start..begin + cols.end);
         let rows = &d_pattern[p0..];
-        let m = rows.partition_point(|&r| r < begin + cols.end);
         if m == 0 {
             return;
         }
@@ -684,6 +683,14 @@ impl<'a> Context<'a> {
     }
 }
 
+/// Where a descendant's ascending `pattern` reaches the target columns `columns` (its first
+/// row there or below), and how many of its rows from there lie in them.
+fn rows_from(pattern: &[usize], columns: Range<usize>) -> (usize, usize) {
+    let first = pattern.partition_point(|&r| r < columns.start);
+    let m = pattern[first..].partition_point(|&r| r < columns.end);
+    (first, m)
+}
+
 /// The column at which supernode `s`'s descendant updates split into two halves of equal
 /// work, to within one column's (in 1..width, for a width of 2 or more): a descendant of
 /// width k whose rows from s's first column on number n puts n − q entries, k multiply-adds
@@ -696,8 +703,8 @@ fn balanced_split(sym: Symbolic<'_>, plan: &SupernodalPlan, s: usize) -> usize {
         let d = d as usize;
         let k = sym.supernode_end()[d] - sym.supernode_begin()[d];
         let pattern = sym.pattern(d);
-        let rows = &pattern[pattern.partition_point(|&r| r < begin)..];
-        let m = rows.partition_point(|&r| r < end);
+        let (p0, m) = rows_from(pattern, begin..end);
+        let rows = &pattern[p0..];
         for (q, &r) in rows[..m].iter().enumerate() {
             work[r - begin] += ((rows.len() - q) * k) as f64;
         }
