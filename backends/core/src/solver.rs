@@ -173,6 +173,25 @@ impl dyn LinearSolver {
 
     /// Checks that the matrix is square, of order `n` when given, with finite values.
     pub fn check_matrix(a: CscRef<'_>, n: Option<usize>) -> Result<(), SolverError> {
+        Self::check_order(a, n)?;
+        match Self::non_finite_error(a) {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    /// The error for the matrix's first NaN or infinite value, if it has one (what
+    /// [`check_matrix`](Self::check_matrix) reports): for a backend that reads every value
+    /// anyway and looks for the first only once it met one.
+    pub fn non_finite_error(a: CscRef<'_>) -> Option<SolverError> {
+        a.first_non_finite().map(|index| SolverError::NonFinite {
+            what: "matrix",
+            index,
+        })
+    }
+
+    /// Checks that the matrix is square and of order `n` when given (the values unread).
+    pub fn check_order(a: CscRef<'_>, n: Option<usize>) -> Result<(), SolverError> {
         if a.nrows() != a.ncols() {
             return Err(SolverError::DimensionMismatch(format!(
                 "matrix is {}×{}, not square",
@@ -187,12 +206,6 @@ impl dyn LinearSolver {
                     a.ncols()
                 )));
             }
-        }
-        if let Some(i) = a.first_non_finite() {
-            return Err(SolverError::NonFinite {
-                what: "matrix",
-                index: i,
-            });
         }
         Ok(())
     }

@@ -509,7 +509,11 @@ impl LinearSolver for FaerCholesky {
             .analysis
             .as_ref()
             .ok_or(SolverError::OutOfOrder("factorize", "analyze"))?;
-        <dyn LinearSolver>::check_matrix(a, Some(an.n))?;
+        // The task kernel checks the values where it gathers them.
+        match an.kernel {
+            Kernel::Tasks(_) => <dyn LinearSolver>::check_order(a, Some(an.n))?,
+            Kernel::Faer(_) => <dyn LinearSolver>::check_matrix(a, Some(an.n))?,
+        }
         if a.fingerprint() != an.fingerprint {
             return Err(SolverError::PatternChanged);
         }
@@ -534,7 +538,11 @@ impl LinearSolver for FaerCholesky {
                 if pool.bytes() <= KEPT_WORKSPACE_BYTES {
                     self.task_scratch = pool;
                 }
-                self.factor = Some(Arc::new(f?));
+                // Any failure may come from a value that is not finite (the kernel stops at
+                // the first it meets, or at a pivot it spoilt, or the scale at a diagonal):
+                // the first such value is the error, as `check_matrix` reports it.
+                let f = f.map_err(|e| <dyn LinearSolver>::non_finite_error(a).unwrap_or(e))?;
+                self.factor = Some(Arc::new(f));
                 return Ok(());
             }
         };
@@ -906,6 +914,50 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// The task kernel checks A's values where it gathers them: a NaN or an infinity in
+    /// either triangle or on the diagonal is reported at its index as `check_matrix` reports
+    /// it (the lowest of two), not as the pivot it spoils, and the next factorization of
+    /// the finite values solves as the first did, bit for bit.
+    #[test]
+    fn the_task_kernel_reports_the_first_non_finite_value() {
+        let (n, a, mut s) = grid_factor(16);
+        let an = s.analysis.as_ref().unwrap();
+        assert!(matches!(an.kernel, Kernel::Tasks(_)));
+        let before = solved(&mut s, &vec![1.0; n]);
+        let csc = a.as_ref();
+        let entry = |i: usize, j: usize| {
+            (csc.col_ptr()[j]..csc.col_ptr()[j + 1])
+                .find(|&k| csc.row_idx()[k] == i)
+                .unwrap()
+        };
+        let (upper, lower, diagonal) = (entry(3, 259), entry(510, 494), entry(777, 777));
+        for bad in [
+            vec![(upper, f64::NAN)],
+            vec![(lower, f64::INFINITY)],
+            vec![(diagonal, f64::NAN)],
+            vec![(diagonal, f64::NEG_INFINITY), (upper, f64::NAN)],
+        ] {
+            let mut b = a.clone();
+            for &(k, v) in &bad {
+                b.values_mut()[k] = v;
+            }
+            let first = bad.iter().map(|&(k, _)| k).min().unwrap();
+            match s.factorize(b.as_ref()) {
+                Err(SolverError::NonFinite {
+                    what: "matrix",
+                    index,
+                }) => assert_eq!(index, first, "{bad:?}"),
+                other => panic!("{bad:?}: {other:?}"),
+            }
+            s.factorize(a.as_ref()).unwrap();
+            let x = solved(&mut s, &vec![1.0; n]);
+            assert!(x
+                .iter()
+                .zip(&before)
+                .all(|(p, q)| p.to_bits() == q.to_bits()));
         }
     }
 
