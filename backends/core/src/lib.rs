@@ -38,7 +38,7 @@ pub use csc::{CscMatrix, CscRef, PatternFingerprint};
 pub use error::{SolverError, StopReason};
 pub use factor_pcg::{pcg_with_factor, FactorPcg};
 pub use forward::{ForwardBlock, ForwardColumns};
-pub use lower::{permuted_diagonal_scale, LowerTriangle};
+pub use lower::{permuted_diagonal_scale, DiagonalEntries, LowerTriangle};
 pub use matrix_market::{read_matrix_market, read_matrix_market_dense};
 pub use median::median;
 pub use ordering::{

@@ -26,11 +26,11 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use fibercell_solver::{
-    compute_ordering, permuted_diagonal_scale, AnalyzeInfo, Capabilities, CscRef, FillEstimate,
+    compute_ordering, AnalyzeInfo, Capabilities, CscRef, DiagonalEntries, FillEstimate,
     FillOrdering, ForwardColumns, LinearSolver, LowerTriangle, NodeGraph, NodeTree,
     PatternFingerprint, Permutation, SolveInfo, SolverError,
 };
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// LLᵀ or LDLᵀ (no square roots; same sparsity).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -82,6 +82,9 @@ struct Analysis {
     schedule: SolveSchedule,
     /// Which numeric kernel factorizes, with what it reads.
     kernel: Kernel,
+    /// Where A's diagonal entries lie, found by the task kernel's first factorization and
+    /// read by the next ones for the scale.
+    diagonal: OnceLock<DiagonalEntries>,
 }
 
 impl Analysis {
@@ -351,7 +354,9 @@ fn factorize_with_tasks(
             message: "a task plan without a supernodal factor (an internal error)".into(),
         });
     };
-    let scale = permuted_diagonal_scale(a, &an.perm.fwd, &mut f.scale)?;
+    // The pattern is the analysis's (its fingerprint was checked).
+    let diagonal = an.diagonal.get_or_init(|| DiagonalEntries::of(a));
+    let scale = diagonal.permuted_scale(a, &an.perm.fwd, &mut f.scale)?;
     let scaled = ScaledMatrix {
         a,
         fwd: &an.perm.fwd,
@@ -499,6 +504,7 @@ impl LinearSolver for FaerCholesky {
             tree,
             symbolic,
             kernel,
+            diagonal: OnceLock::new(),
         }));
         self.prefaulted = prefault;
         Ok(info)
@@ -959,6 +965,31 @@ mod tests {
                 .zip(&before)
                 .all(|(p, q)| p.to_bits() == q.to_bits()));
         }
+    }
+
+    /// The task kernel's later factorizations read the scale at the diagonal entries the
+    /// first one found: with a diagonal raised unevenly (so that S A S changes), the
+    /// refactorized solver solves as a fresh one, bit for bit.
+    #[test]
+    fn a_refactorization_reads_the_new_diagonal() {
+        let (n, a, mut s) = grid_factor(16);
+        assert!(s.analysis.as_ref().unwrap().diagonal.get().is_some());
+        let mut b = a.clone();
+        let csc = a.as_ref();
+        for j in 0..n {
+            let k = (csc.col_ptr()[j]..csc.col_ptr()[j + 1])
+                .find(|&k| csc.row_idx()[k] == j)
+                .unwrap();
+            b.values_mut()[k] *= 1.0 + (j % 3) as f64;
+        }
+        s.factorize(b.as_ref()).unwrap();
+        let mut fresh = FaerCholesky::new(CholeskyVariant::Llt, FillOrdering::NestedDissection);
+        fresh.analyze(b.as_ref()).unwrap();
+        fresh.factorize(b.as_ref()).unwrap();
+        let rhs: Vec<f64> = (0..n).map(|i| (i % 7) as f64 - 3.0).collect();
+        let (x, y) = (solved(&mut s, &rhs), solved(&mut fresh, &rhs));
+        assert!(x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()));
+        assert!(relative_residual(&b, &x, &rhs) < 1e-8);
     }
 
     /// The values' check runs beside the ordering and still comes first: a NaN in a pattern
