@@ -13,7 +13,7 @@
 //! follows holds the mapped buffer (the factor's size) until its solver analyzes again or is
 //! dropped.
 
-use fibercell_solver::extend_with_zeros_par;
+use fibercell_solver::{extend_with_zeros, extend_with_zeros_par};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -118,7 +118,7 @@ fn map(target: &Target) -> Vec<f64> {
             break;
         }
         let next = want.min(values.len() + CHUNK);
-        values.resize(next, 0.0);
+        extend_with_zeros(&mut values, next);
     }
     values
 }
