@@ -50,4 +50,4 @@ pub use residual::{
     relative_residual, solve_checked, solve_checked_into, vector_norm_inf, SolveReport,
 };
 pub use solver::{AnalyzeInfo, Capabilities, LinearSolver, SolveInfo};
-pub use zeros::{extend_with_zeros, extend_with_zeros_par};
+pub use zeros::{extend_with_zeros, extend_with_zeros_par, populate_par};
