@@ -181,8 +181,8 @@ impl dyn LinearSolver {
     }
 
     /// The error for the matrix's first NaN or infinite value, if it has one (what
-    /// [`check_matrix`](Self::check_matrix) reports): for a backend that reads every value
-    /// anyway and looks for the first only once it met one.
+    /// `check_matrix` reports): for a backend that reads every value anyway and looks for the
+    /// first only once it met one.
     pub fn non_finite_error(a: CscRef<'_>) -> Option<SolverError> {
         a.first_non_finite().map(|index| SolverError::NonFinite {
             what: "matrix",

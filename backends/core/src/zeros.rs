@@ -75,8 +75,8 @@ fn populate_for_write<T>(chunk: &mut [T]) {
     let (first, last) = (start.next_multiple_of(PAGE), end / PAGE * PAGE);
     if last > first {
         // SAFETY: [first, last) lies within `chunk`, memory this thread borrows exclusively;
-        // the request maps its pages and changes no byte of it. The result is ignored: a refusal (an older
-        // kernel) leaves the pages to fault at the writes that follow.
+        // the request maps its pages and changes no byte of it. The result is ignored: a
+        // refusal (an older kernel) leaves the pages to fault at the writes that follow.
         unsafe {
             libc::madvise(
                 first as *mut libc::c_void,
