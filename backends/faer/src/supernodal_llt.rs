@@ -75,8 +75,10 @@ pub(crate) struct SupernodalPlan {
     /// Heavy supernodes: their number of children (light subtrees or heavy supernodes).
     heavy_children: Vec<usize>,
     heavy: Vec<bool>,
-    /// Supernodes whose updates (split by columns) and dense kernels run on every thread.
-    parallel_node: Vec<bool>,
+    /// For a supernode whose updates and dense kernels run on every thread, the column at
+    /// which its updates split into two blocks of equal work ([`balanced_split`], ≥ 1); 0 for
+    /// a supernode on one thread. Made once per analysis.
+    parallel_split: Vec<u32>,
     /// [`TaskSizes::one_product_work`].
     one_product_work: usize,
 }
@@ -118,9 +120,16 @@ impl SupernodalPlan {
             }
         }
         let (light_ptr, light_nodes) = light_tasks(&parent, &heavy);
-        let parallel_node = own
-            .iter()
-            .map(|&w| threads > 1 && w > sizes.parallel_node)
+        let parallel_split = (0..ns)
+            .map(|s| {
+                if threads > 1 && own[s] > sizes.parallel_node {
+                    let list = &updaters[updater_ptr[s]..updater_ptr[s + 1]];
+                    // Fits: the plan checked n ≤ u32::MAX.
+                    balanced_split(sym, list, s) as u32
+                } else {
+                    0
+                }
+            })
             .collect();
         Some(SupernodalPlan {
             parent,
@@ -130,7 +139,7 @@ impl SupernodalPlan {
             light_nodes,
             heavy_children,
             heavy,
-            parallel_node,
+            parallel_split,
             one_product_work: sizes.one_product_work,
         })
     }
@@ -484,7 +493,7 @@ impl<'a> Context<'a> {
         if self.failure.any.load(Ordering::Acquire) {
             return;
         }
-        let par = if self.plan.parallel_node[s] {
+        let par = if self.plan.parallel_split[s] > 0 {
             Par::rayon(self.threads)
         } else {
             Par::Seq
@@ -559,7 +568,7 @@ impl<'a> Context<'a> {
         } else {
             // Two column blocks of equal update work, each updated by every descendant on its
             // own thread.
-            let split = balanced_split(self.sym, self.plan, s);
+            let split = self.plan.parallel_split[s] as usize;
             let (left, right) = l.rb_mut().split_at_col_mut(split);
             let mut other = self.take_scratch();
             rayon::join(
@@ -701,15 +710,15 @@ fn rows_from(pattern: &[usize], columns: Range<usize>) -> (usize, usize) {
     (first, m)
 }
 
-/// The column at which supernode `s`'s descendant updates split into two halves of equal
-/// work, to within one column's (in 1..width, for a width of 2 or more): a descendant of
+/// The column at which the updates of supernode `s` by its descendants `updaters` split into
+/// two halves of equal work, to within one column's (in 1..width, for a width of 2 or more): a descendant of
 /// width k whose rows from s's first column on number n puts n − q entries, k multiply-adds
 /// each, into the column of its q-th row. (Halves of equal area left the updates of L seed
 /// 1's root at 0.085 s on one thread and 0.15–0.2 s on the other; now 0.115–0.135 s each.)
-fn balanced_split(sym: Symbolic<'_>, plan: &SupernodalPlan, s: usize) -> usize {
+fn balanced_split(sym: Symbolic<'_>, updaters: &[u32], s: usize) -> usize {
     let (begin, end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
     let mut work = vec![0.0f64; end - begin];
-    for &d in &plan.updaters[plan.updater_ptr[s]..plan.updater_ptr[s + 1]] {
+    for &d in updaters {
         let d = d as usize;
         let k = sym.supernode_end()[d] - sym.supernode_begin()[d];
         let pattern = sym.pattern(d);
@@ -932,7 +941,7 @@ mod tests {
         }
         let plan = SupernodalPlan::new(case.supernodal(), 2, TINY).unwrap();
         assert!(plan.heavy.iter().any(|&h| h) && plan.light_ptr.len() > 2);
-        assert!(plan.parallel_node.iter().any(|&p| p));
+        assert!(plan.parallel_split.iter().any(|&p| p > 0));
     }
 
     /// A parallel supernode's two column blocks carry equal update work, counted here entry by
@@ -945,7 +954,7 @@ mod tests {
         let sym = case.supernodal();
         let plan = SupernodalPlan::new(sym, 2, TINY).unwrap();
         let mut tested = 0;
-        for s in (0..sym.n_supernodes()).filter(|&s| plan.parallel_node[s]) {
+        for s in (0..sym.n_supernodes()).filter(|&s| plan.parallel_split[s] > 0) {
             let (begin, end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
             let mut work = vec![0usize; end - begin];
             for &d in &plan.updaters[plan.updater_ptr[s]..plan.updater_ptr[s + 1]] {
@@ -966,7 +975,7 @@ mod tests {
             if end - begin < 2 || work.iter().all(|&w| w == 0) {
                 continue;
             }
-            let split = balanced_split(sym, &plan, s);
+            let split = plan.parallel_split[s] as usize;
             let (left, right): (usize, usize) =
                 (work[..split].iter().sum(), work[split..].iter().sum());
             let widest = *work.iter().max().unwrap();
