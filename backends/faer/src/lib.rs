@@ -36,6 +36,7 @@ mod block_tree;
 mod cholesky;
 mod column_layout;
 mod dense_forward;
+mod dense_llt;
 mod lu;
 mod permute;
 mod pivots;

@@ -10,6 +10,7 @@
 //! CHOLMOD's supernodal numeric factorization): gather A's columns, subtract every descendant's
 //! update L_d,bottom L_d,midᵀ, factorize the diagonal block and solve the rows below it.
 
+use crate::dense_llt::{self, llt_two_threads, solve_below_two_threads};
 use crate::supernodes::SupernodesRef;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{
@@ -17,7 +18,7 @@ use faer::linalg::cholesky::llt::factor::{
 };
 use faer::linalg::matmul::{matmul, triangular};
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
-use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::reborrow::{IntoConst, Reborrow, ReborrowMut};
 use faer::{Accum, MatMut, MatRef, Par, Spec};
 use fibercell_solver::CscRef;
 use std::marker::PhantomData;
@@ -47,6 +48,12 @@ pub(crate) struct TaskSizes {
     /// ≈ 0.3 µs more per call at these sizes, which the square's waste (m² k flops) is worth
     /// at ≈ 50 GFLOP/s: measured single products of 12–600 rows, `Par::Seq`, AVX-512.
     pub(crate) one_product_work: usize,
+    /// A parallel supernode's diagonal block of at least this many columns is factorized by
+    /// [`llt_two_threads`], a narrower one by faer's kernel on one thread. Measured alone,
+    /// faer on one thread / faer on two / [`llt_two_threads`], GFLOP/s: 400 columns
+    /// 45 / 30 / 41, 600: 52 / 42 / 56, 1,218: 58 / 70 / 86, 3,036: 57 / 93 / 106 (Intel VM,
+    /// two-thread DGEMM ≈ 155).
+    pub(crate) two_thread_llt: usize,
 }
 
 impl Default for TaskSizes {
@@ -55,6 +62,7 @@ impl Default for TaskSizes {
             min_task: 1e6,
             parallel_node: 2e7,
             one_product_work: 1 << 14,
+            two_thread_llt: 512,
         }
     }
 }
@@ -81,6 +89,8 @@ pub(crate) struct SupernodalPlan {
     parallel_split: Vec<u32>,
     /// [`TaskSizes::one_product_work`].
     one_product_work: usize,
+    /// [`TaskSizes::two_thread_llt`].
+    two_thread_llt: usize,
 }
 
 impl SupernodalPlan {
@@ -141,6 +151,7 @@ impl SupernodalPlan {
             heavy,
             parallel_split,
             one_product_work: sizes.one_product_work,
+            two_thread_llt: sizes.two_thread_llt,
         })
     }
 }
@@ -294,6 +305,31 @@ struct Scratch {
     buffers: UpdateBuffers,
     stack: Option<MemBuffer>,
     stack_dim: usize,
+}
+
+impl Scratch {
+    /// The stack of faer's dense LLᵀ for a diagonal block of `width` columns (enough for
+    /// [`llt_two_threads`]'s blocks too), grown when too small. faer asks for one column of
+    /// `width` whatever the threads.
+    fn stack_for(&mut self, width: usize) -> &mut MemStack {
+        let width = width.max(dense_llt::BLOCK);
+        if self.stack.is_none() || self.stack_dim < width {
+            let req = cholesky_in_place_scratch::<f64>(width, Par::Seq, Spec::default());
+            self.stack = Some(MemBuffer::new(req));
+            self.stack_dim = width;
+        }
+        MemStack::new(self.stack.as_mut().expect("allocated above"))
+    }
+}
+
+/// faer's dense LLᵀ of the diagonal block `top` on `par`; the column of a pivot that is not
+/// positive as the error.
+fn llt(top: MatMut<'_, f64>, par: Par, stack: &mut MemStack) -> Result<(), usize> {
+    let reg = LltRegularization::default();
+    match cholesky_in_place(top, reg, par, stack, Spec::default()) {
+        Err(LltError::NonPositivePivot { index }) => Err(index),
+        Ok(_) => Ok(()),
+    }
 }
 
 /// The scratch of a factorization's tasks, kept for the next factorization. Made anew each
@@ -577,22 +613,10 @@ impl<'a> Context<'a> {
             );
             self.put_scratch(other);
         }
-        let (mut top, bottom) = l.split_at_row_mut(width);
-        if scratch.stack.is_none() || scratch.stack_dim < width {
-            let req = cholesky_in_place_scratch::<f64>(width, par, Spec::default());
-            scratch.stack = Some(MemBuffer::new(req));
-            scratch.stack_dim = width;
-        }
-        let stack = MemStack::new(scratch.stack.as_mut().expect("allocated above"));
-        let reg = LltRegularization::default();
-        if let Err(LltError::NonPositivePivot { index }) =
-            cholesky_in_place(top.rb_mut(), reg, par, stack, Spec::default())
-        {
-            return Err(Pivot {
-                index: begin + index,
-                value: 0.0,
-            });
-        }
+        let top = self.dense_step(l, par, scratch).map_err(|index| Pivot {
+            index: begin + index,
+            value: 0.0,
+        })?;
         // faer accepts tiny positive pivots: judge them against the (unit) scaled diagonal.
         for c in 0..width {
             let pivot = top[(c, c)] * top[(c, c)];
@@ -603,8 +627,35 @@ impl<'a> Context<'a> {
                 });
             }
         }
-        solve_lower_triangular_in_place(top.rb(), bottom.transpose_mut(), par);
         Ok(())
+    }
+
+    /// The dense step of a supernode held in `l` (its rows × its columns, updated): the
+    /// diagonal block factorized and the rows below it solved against its transpose. On two
+    /// threads a wide diagonal block goes to [`llt_two_threads`] and the rows below are solved
+    /// in two halves; on more, faer's kernels take every thread. The diagonal block, or the
+    /// column of a pivot that is not positive.
+    fn dense_step<'l>(
+        &self,
+        l: MatMut<'l, f64>,
+        par: Par,
+        scratch: &mut Scratch,
+    ) -> Result<MatRef<'l, f64>, usize> {
+        let width = l.ncols();
+        let (mut top, bottom) = l.split_at_row_mut(width);
+        let two = self.threads == 2 && par != Par::Seq;
+        let stack = scratch.stack_for(width);
+        if two && width >= self.plan.two_thread_llt {
+            llt_two_threads(top.rb_mut(), stack)?;
+        } else {
+            llt(top.rb_mut(), if two { Par::Seq } else { par }, stack)?;
+        }
+        if two {
+            solve_below_two_threads(top.rb(), bottom);
+        } else {
+            solve_lower_triangular_in_place(top.rb(), bottom.transpose_mut(), par);
+        }
+        Ok(top.into_const())
     }
 
     /// Subtracts every descendant's update from the columns `cols` of supernode `s`, held in
@@ -711,9 +762,9 @@ fn rows_from(pattern: &[usize], columns: Range<usize>) -> (usize, usize) {
 }
 
 /// The column at which the updates of supernode `s` by its descendants `updaters` split into
-/// two halves of equal work, to within one column's (in 1..width, for a width of 2 or more): a descendant of
-/// width k whose rows from s's first column on number n puts n − q entries, k multiply-adds
-/// each, into the column of its q-th row. (Halves of equal area left the updates of L seed
+/// two halves of equal work, to within one column's (in 1..width, for a width of 2 or more):
+/// a descendant of width k whose rows from s's first column on number n puts n − q entries,
+/// k multiply-adds each, into the column of its q-th row. (Halves of equal area left the updates of L seed
 /// 1's root at 0.085 s on one thread and 0.15–0.2 s on the other; now 0.115–0.135 s each.)
 fn balanced_split(sym: Symbolic<'_>, updaters: &[u32], s: usize) -> usize {
     let (begin, end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
@@ -899,11 +950,19 @@ mod tests {
     }
 
     /// Cuts small enough that a 10³ grid has light subtrees, heavy supernodes and supernodes
-    /// whose updates are split over two threads.
+    /// whose updates are split over two threads, whose diagonal blocks go to
+    /// [`llt_two_threads`].
     const TINY: TaskSizes = TaskSizes {
         min_task: 1e3,
         parallel_node: 1e4,
         one_product_work: 1 << 14,
+        two_thread_llt: 8,
+    };
+
+    /// The same, every diagonal block on one thread.
+    const TINY_ONE_THREAD_LLT: TaskSizes = TaskSizes {
+        two_thread_llt: usize::MAX,
+        ..TINY
     };
 
     /// The default sizes with every update one product, or none.
@@ -923,6 +982,7 @@ mod tests {
             (1, TaskSizes::default()),
             (2, TaskSizes::default()),
             (2, TINY),
+            (2, TINY_ONE_THREAD_LLT),
             (3, TINY),
             (1, products(0)),
             (1, products(usize::MAX)),
@@ -1023,7 +1083,11 @@ mod tests {
             Err(LltError::NonPositivePivot { index }) => index,
             Ok(_) => panic!("faer factorized an indefinite matrix"),
         };
-        for (threads, sizes) in [(1, TaskSizes::default()), (2, TINY)] {
+        for (threads, sizes) in [
+            (1, TaskSizes::default()),
+            (2, TINY),
+            (2, TINY_ONE_THREAD_LLT),
+        ] {
             match case.ours(threads, sizes) {
                 Err(p) => assert_eq!(p.index, expected, "threads {threads}"),
                 Ok(_) => panic!("threads {threads}: factorized an indefinite matrix"),

@@ -4,7 +4,7 @@
 
 /// Bottom first; a module may import the ones of lower layers only.
 const LAYERS: &[&[&str]] = &[
-    &["prefault", "supernodes"],
+    &["dense_llt", "prefault", "supernodes"],
     &["symbolic"],
     &[
         "block_tree",
