@@ -578,7 +578,6 @@ impl<'a> Context<'a> {
         // SAFETY: supernode s is written by this task only, and read by its ancestors' tasks,
         // which start after this one ends.
         let ls = unsafe { self.values.block_mut(range) };
-        ls.fill(0.0);
         let position = &mut scratch.position;
         position.resize(self.sym.nrows(), 0);
         // Fits: the plan checked n ≤ u32::MAX.
@@ -588,14 +587,18 @@ impl<'a> Context<'a> {
         {
             position[r] = k as u32;
         }
-        for (j, column) in ls.chunks_exact_mut(rows).enumerate() {
-            // A's entries lie in the factor's pattern.
-            if !self.a.add_column(begin + j, &scratch.position, column) {
-                return Err(Pivot {
-                    index: begin + j,
-                    value: f64::NAN,
-                });
-            }
+        if par == Par::Seq || width < 2 {
+            self.gather(ls, rows, begin, &scratch.position)?;
+        } else {
+            // The halves of the columns side by side: L's root clears and gathers 74 MB.
+            let half = width / 2;
+            let (left, right) = ls.split_at_mut(half * rows);
+            let position = &scratch.position;
+            let (first, second) = rayon::join(
+                || self.gather(left, rows, begin, position),
+                || self.gather(right, rows, begin + half, position),
+            );
+            first.and(second)?;
         }
         let mut l = MatMut::from_column_major_slice_mut(ls, rows, width);
         let (position, buffers) = (&scratch.position, &mut scratch.buffers);
@@ -656,6 +659,28 @@ impl<'a> Context<'a> {
             solve_lower_triangular_in_place(top.rb(), bottom.transpose_mut(), par);
         }
         Ok(top.into_const())
+    }
+
+    /// Clears `block`, a supernode's columns from column `first` on (`rows` values each), and
+    /// gathers A's columns into them, each row at its `position`.
+    fn gather(
+        &self,
+        block: &mut [f64],
+        rows: usize,
+        first: usize,
+        position: &[u32],
+    ) -> Result<(), Pivot> {
+        block.fill(0.0);
+        for (j, column) in block.chunks_exact_mut(rows).enumerate() {
+            // A's entries lie in the factor's pattern.
+            if !self.a.add_column(first + j, position, column) {
+                return Err(Pivot {
+                    index: first + j,
+                    value: f64::NAN,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Subtracts every descendant's update from the columns `cols` of supernode `s`, held in
@@ -764,8 +789,9 @@ fn rows_from(pattern: &[usize], columns: Range<usize>) -> (usize, usize) {
 /// The column at which the updates of supernode `s` by its descendants `updaters` split into
 /// two halves of equal work, to within one column's (in 1..width, for a width of 2 or more):
 /// a descendant of width k whose rows from s's first column on number n puts n − q entries,
-/// k multiply-adds each, into the column of its q-th row. (Halves of equal area left the updates of L seed
-/// 1's root at 0.085 s on one thread and 0.15–0.2 s on the other; now 0.115–0.135 s each.)
+/// k multiply-adds each, into the column of its q-th row. (Halves of equal area left the
+/// updates of L seed 1's root at 0.085 s on one thread and 0.15–0.2 s on the other; now
+/// 0.115–0.135 s each.)
 fn balanced_split(sym: Symbolic<'_>, updaters: &[u32], s: usize) -> usize {
     let (begin, end) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
     let mut work = vec![0.0f64; end - begin];
@@ -1002,6 +1028,33 @@ mod tests {
         let plan = SupernodalPlan::new(case.supernodal(), 2, TINY).unwrap();
         assert!(plan.heavy.iter().any(|&h| h) && plan.light_ptr.len() > 2);
         assert!(plan.parallel_split.iter().any(|&p| p > 0));
+    }
+
+    /// A value that is not finite in the last column, which a parallel root gathers in the
+    /// second half of its columns, is reported at that column: an upper-triangle entry, so
+    /// nothing but the gather's check sees it (the factor would come out finite).
+    #[test]
+    fn a_nan_in_a_parallel_supernodes_second_half_is_reported() {
+        let mut case = Case::new(grid(10));
+        let n = case.fwd.len();
+        let plan = SupernodalPlan::new(case.supernodal(), 2, TINY).unwrap();
+        let root = case.supernodal().n_supernodes() - 1;
+        assert!(plan.parallel_split[root] > 0, "the root is not parallel");
+        let column = case.fwd[n - 1];
+        let a = case.a.as_ref();
+        let k = (a.col_ptr()[column]..a.col_ptr()[column + 1])
+            .find(|&k| a.row_idx()[k] != column)
+            .unwrap();
+        case.a.values_mut()[k] = f64::NAN;
+        for (threads, sizes) in [(2, TINY), (1, TaskSizes::default())] {
+            match case.ours(threads, sizes) {
+                Err(p) => {
+                    assert_eq!(p.index, n - 1, "threads {threads}");
+                    assert!(p.value.is_nan());
+                }
+                Ok(_) => panic!("threads {threads}: a NaN went unreported"),
+            }
+        }
     }
 
     /// A parallel supernode's two column blocks carry equal update work, counted here entry by
