@@ -8,7 +8,8 @@
 //! rows split over the two threads, and the trailing lower triangle updated by the block column's
 //! rank-[`BLOCK`] product in two column ranges of equal work — the bulk of the flops, as a few
 //! large products. The splits are two-way (`rayon::join`): the kernel calls it when the pool has
-//! two threads, and faer's own kernel on more.
+//! two threads, and faer's own kernel on more. [`lower_product`], the one-thread lower-trapezoid
+//! product of these updates, is also each descendant's update of a supernode.
 
 use faer::dyn_stack::MemStack;
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, LltError, LltRegularization};
@@ -70,20 +71,26 @@ fn update_trailing(a21: MatRef<'_, f64>, a22: MatMut<'_, f64>) {
     let (left, right) = a22.split_at_col_mut(split);
     let right = right.subrows_mut(split, t - split);
     rayon::join(
-        || lower_product(left, a21, a21.subrows(0, split)),
+        || lower_product(left, a21, a21.subrows(0, split), Accum::Add),
         || {
             lower_product(
                 right,
                 a21.subrows(split, t - split),
                 a21.subrows(split, t - split),
+                Accum::Add,
             )
         },
     );
 }
 
-/// dst −= below midᵀ where dst's top m × m square (m = mid's rows) is lower triangular: only
-/// its lower half is written.
-fn lower_product(dst: MatMut<'_, f64>, below: MatRef<'_, f64>, mid: MatRef<'_, f64>) {
+/// dst = (or +=, by `accum`) −below · midᵀ on this thread, `mid` being `below`'s first rows:
+/// the top square only on and below its diagonal.
+pub(crate) fn lower_product(
+    dst: MatMut<'_, f64>,
+    below: MatRef<'_, f64>,
+    mid: MatRef<'_, f64>,
+    accum: Accum,
+) {
     let m = mid.nrows();
     if m == 0 {
         return;
@@ -92,7 +99,7 @@ fn lower_product(dst: MatMut<'_, f64>, below: MatRef<'_, f64>, mid: MatRef<'_, f
     triangular::matmul(
         top,
         triangular::BlockStructure::TriangularLower,
-        Accum::Add,
+        accum,
         mid,
         triangular::BlockStructure::Rectangular,
         mid.transpose(),
@@ -102,7 +109,7 @@ fn lower_product(dst: MatMut<'_, f64>, below: MatRef<'_, f64>, mid: MatRef<'_, f
     );
     matmul(
         bottom,
-        Accum::Add,
+        accum,
         below.subrows(m, below.nrows() - m),
         mid.transpose(),
         -1.0,

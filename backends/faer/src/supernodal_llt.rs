@@ -10,13 +10,13 @@
 //! CHOLMOD's supernodal numeric factorization): gather A's columns, subtract every descendant's
 //! update L_d,bottom L_d,midᵀ, factorize the diagonal block and solve the rows below it.
 
-use crate::dense_llt::{self, llt_two_threads, solve_below_two_threads};
+use crate::dense_llt::{self, llt_two_threads, lower_product, solve_below_two_threads};
 use crate::supernodes::SupernodesRef;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{
     cholesky_in_place, cholesky_in_place_scratch, LltError, LltRegularization,
 };
-use faer::linalg::matmul::{matmul, triangular};
+use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{IntoConst, Reborrow, ReborrowMut};
 use faer::{Accum, MatMut, MatRef, Par, Spec};
@@ -734,7 +734,7 @@ impl<'a> Context<'a> {
         let one_product = m * m * d_width <= self.plan.one_product_work;
         if contiguous && !one_product {
             let dst = l.submatrix_mut(local[0], local[0] - cols.start, n, m);
-            product(dst, below, mid, Accum::Add);
+            lower_product(dst, below, mid, Accum::Add);
             return;
         }
         if buffers.update.len() < n * m {
@@ -744,7 +744,7 @@ impl<'a> Context<'a> {
         if one_product {
             matmul(w, Accum::Replace, below, mid.transpose(), -1.0, Par::Seq);
         } else {
-            product(w, below, mid, Accum::Replace);
+            lower_product(w, below, mid, Accum::Replace);
         }
         // Scatter the lower trapezoid of the product: column j of it goes to s's column
         // local[j], its rows i ≥ j to rows local[i].
@@ -822,33 +822,6 @@ fn balanced_split(sym: Symbolic<'_>, updaters: &[u32], s: usize) -> usize {
         done += w;
     }
     split.clamp(1, work.len().saturating_sub(1).max(1))
-}
-
-/// dst = (or +=, by `accum`) −below · midᵀ, `mid` being `below`'s first rows: the top square
-/// only on and below its diagonal.
-fn product(dst: MatMut<'_, f64>, below: MatRef<'_, f64>, mid: MatRef<'_, f64>, accum: Accum) {
-    let par = Par::Seq;
-    let m = mid.nrows();
-    let (top, bottom) = dst.split_at_row_mut(m);
-    triangular::matmul(
-        top,
-        triangular::BlockStructure::TriangularLower,
-        accum,
-        mid,
-        triangular::BlockStructure::Rectangular,
-        mid.transpose(),
-        triangular::BlockStructure::Rectangular,
-        -1.0,
-        par,
-    );
-    matmul(
-        bottom,
-        accum,
-        below.subrows(m, below.nrows() - m),
-        mid.transpose(),
-        -1.0,
-        par,
-    );
 }
 
 #[cfg(test)]
