@@ -34,15 +34,7 @@ pub(crate) fn llt_two_threads(mut a: MatMut<'_, f64>, stack: &mut MemStack) -> R
         let kb = BLOCK.min(n - k);
         let rest = a.rb_mut().submatrix_mut(k, k, n - k, n - k);
         let (mut a11, _, mut a21, a22) = rest.split_at_mut(kb, kb);
-        if let Err(LltError::NonPositivePivot { index }) = cholesky_in_place(
-            a11.rb_mut(),
-            LltRegularization::default(),
-            Par::Seq,
-            stack,
-            Spec::default(),
-        ) {
-            return Err(k + index);
-        }
+        llt(a11.rb_mut(), Par::Seq, stack).map_err(|index| k + index)?;
         if a21.nrows() > 0 {
             solve_below_two_threads(a11.rb(), a21.rb_mut());
             update_trailing(a21.rb(), a22);
@@ -50,6 +42,16 @@ pub(crate) fn llt_two_threads(mut a: MatMut<'_, f64>, stack: &mut MemStack) -> R
         k += kb;
     }
     Ok(())
+}
+
+/// faer's dense LLᵀ of the square `a` on `par`; the column of a pivot that is not positive
+/// as the error.
+pub(crate) fn llt(a: MatMut<'_, f64>, par: Par, stack: &mut MemStack) -> Result<(), usize> {
+    let reg = LltRegularization::default();
+    match cholesky_in_place(a, reg, par, stack, Spec::default()) {
+        Err(LltError::NonPositivePivot { index }) => Err(index),
+        Ok(_) => Ok(()),
+    }
 }
 
 /// a21 ← a21 L11⁻ᵀ, the rows in two halves side by side.

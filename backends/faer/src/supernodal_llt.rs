@@ -10,12 +10,10 @@
 //! CHOLMOD's supernodal numeric factorization): gather A's columns, subtract every descendant's
 //! update L_d,bottom L_d,midᵀ, factorize the diagonal block and solve the rows below it.
 
-use crate::dense_llt::{self, llt_two_threads, lower_product, solve_below_two_threads};
+use crate::dense_llt::{self, llt, llt_two_threads, lower_product, solve_below_two_threads};
 use crate::supernodes::SupernodesRef;
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::{
-    cholesky_in_place, cholesky_in_place_scratch, LltError, LltRegularization,
-};
+use faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch;
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{IntoConst, Reborrow, ReborrowMut};
@@ -319,16 +317,6 @@ impl Scratch {
             self.stack_dim = width;
         }
         MemStack::new(self.stack.as_mut().expect("allocated above"))
-    }
-}
-
-/// faer's dense LLᵀ of the diagonal block `top` on `par`; the column of a pivot that is not
-/// positive as the error.
-fn llt(top: MatMut<'_, f64>, par: Par, stack: &mut MemStack) -> Result<(), usize> {
-    let reg = LltRegularization::default();
-    match cholesky_in_place(top, reg, par, stack, Spec::default()) {
-        Err(LltError::NonPositivePivot { index }) => Err(index),
-        Ok(_) => Ok(()),
     }
 }
 
@@ -828,6 +816,7 @@ fn balanced_split(sym: Symbolic<'_>, updaters: &[u32], s: usize) -> usize {
 mod tests {
     use super::*;
     use crate::test_matrices::grid;
+    use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
     use faer::sparse::linalg::cholesky::{
         factorize_symbolic_cholesky, supernodal, supernodal::SymbolicSupernodalCholesky,
         CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
