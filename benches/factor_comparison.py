@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""faer (fibercell's kernel), CHOLMOD and MKL PARDISO on the same cell matrices, in one run.
+"""faer (fibercell's kernel), CHOLMOD, MKL PARDISO and MUMPS on the same cell matrices, in one run.
 
 For every preset: generate the non-woven (seed 1), export the first cell problem's matrix
 (`fibercell export-matrix`), then time the symbolic analysis and the numeric factorization of
@@ -11,13 +11,18 @@ each solver on it, medians of --repeats runs:
   libcholmod takes the system BLAS, which must be OpenBLAS: the script records which one);
 * MKL PARDISO through pypardiso's MKL (mtype 2, real SPD, upper triangle; METIS nested
   dissection, its default), called directly with 0-based int32 arrays so that no conversion
-  is timed: phase 11 (analysis), 22 (numeric factorization), 33 (a solve, checked).
+  is timed: phase 11 (analysis), 22 (numeric factorization), 33 (a solve, checked);
+* MUMPS 5 (Debian's sequential build, `apt-get install libmumps-seq-dev`: SCOTCH and PORD, no
+  METIS, its dense kernels on OpenBLAS's threads) through `benches/mumps_factor.c`, which the
+  script compiles with `cc` (SPD, MUMPS's automatic ordering; analysis and factorization timed
+  in C). Without the package the rows say why MUMPS is missing and the rest runs.
 
 The machine's bound is measured in the same run: two-thread DGEMM of order 4096 (NumPy's
 OpenBLAS). Each solver's rate is its own flop count over its factorization time; faer's is
 also given as a fraction of that DGEMM rate.
 
     cargo build --release -p fibercell-cli --features cholmod
+    apt-get install libmumps-seq-dev   # optional: the MUMPS rows
     python3 -m venv target/pyenv && target/pyenv/bin/pip install numpy scipy pypardiso
     target/pyenv/bin/python benches/factor_comparison.py --presets M,L --repeats 3 \\
         -o benches/results/factor-comparison.json
@@ -157,6 +162,37 @@ def pardiso_times(mtx, repeats):
     return result
 
 
+MUMPS_SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "mumps_factor.c")
+
+
+def build_mumps(directory):
+    """Compiles benches/mumps_factor.c against Debian's sequential MUMPS: (binary, None), or
+    (None, why not)."""
+    binary = os.path.join(directory, "mumps_factor")
+    cmd = ["cc", "-O2", MUMPS_SOURCE, "-o", binary, "-I/usr/include/mumps_seq", "-ldmumps_seq", "-lm"]
+    try:
+        out = subprocess.run(cmd, capture_output=True, text=True)
+    except OSError as e:
+        return None, f"no C compiler: {e}"
+    if out.returncode != 0:
+        return None, "mumps_factor.c did not build (apt-get install libmumps-seq-dev): " + out.stderr.strip()[-300:]
+    return binary, None
+
+
+def mumps_times(binary, mtx, repeats):
+    return run_json([binary, mtx, str(repeats)])
+
+
+def mumps_version():
+    """Debian's libmumps-seq-dev version, if dpkg knows one."""
+    try:
+        out = subprocess.run(["dpkg-query", "-W", "-f=${Version}", "libmumps-seq-dev"],
+                             capture_output=True, text=True)
+    except OSError:
+        return None
+    return out.stdout.strip() or None
+
+
 def blas_of(binary):
     """The BLAS library the binary's CHOLMOD resolves to."""
     try:
@@ -210,12 +246,16 @@ def main():
         "cholmod_blas": blas_of(args.fibercell),
         "mkl": package_version("mkl"),
         "pypardiso": package_version("pypardiso"),
+        "mumps": mumps_version(),
         "fibercell_commit": git_commit(),
     }
     print(f"DGEMM (NumPy OpenBLAS, 2 threads): {machine['dgemm_gflops_two_threads']:.1f} GFLOP/s; "
           f"CHOLMOD's BLAS: {machine['cholmod_blas']}", flush=True)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
+        mumps, why_not = build_mumps(tmp)
+        if why_not:
+            print(f"MUMPS: {why_not}", flush=True)
         for preset in args.presets.split(","):
             cell = os.path.join(tmp, f"{preset}.toml")
             mtx = os.path.join(tmp, f"{preset}.mtx")
@@ -227,10 +267,13 @@ def main():
             row["faer"] = fibercell_solver(args.fibercell, mtx, "faer-cholesky", args.repeats)
             row["cholmod"] = fibercell_solver(args.fibercell, mtx, "cholmod", args.repeats)
             row["pardiso"] = pardiso_times(mtx, args.repeats)
+            row["mumps"] = mumps_times(mumps, mtx, args.repeats) if mumps else {"unavailable": why_not}
             f = row["faer"]
             f["fraction_of_dgemm"] = f["flops"] / f["factorize_seconds"] / 1e9 / machine["dgemm_gflops_two_threads"]
             row["faer_over_cholmod"] = f["factorize_seconds"] / row["cholmod"]["factorize_seconds"]
             row["faer_over_pardiso"] = f["factorize_seconds"] / row["pardiso"]["factorize_seconds"]
+            if mumps:
+                row["faer_over_mumps"] = f["factorize_seconds"] / row["mumps"]["factorize_seconds"]
             rows.append(row)
             print_row(row)
     report = {"machine": machine, "repeats": args.repeats, "rows": rows}
@@ -244,13 +287,16 @@ def print_row(row):
     print(f"\n{row['preset']} (seed {row['seed']}):")
     print("| solver | ordering | analyze | factorize | nnz(L) | flops | GFLOP/s | backward error |")
     print("|---|---|---:|---:|---:|---:|---:|---:|")
-    for name in ("faer", "cholmod", "pardiso"):
+    for name in ("faer", "cholmod", "pardiso", "mumps"):
         r = row[name]
+        if "unavailable" in r:
+            continue
         rate = r["flops"] / r["factorize_seconds"] / 1e9
         print(f"| {name} | {r['ordering']} | {r['analyze_seconds']:.3f} s | {r['factorize_seconds']:.3f} s | "
               f"{r['nnz_factor']:.3e} | {r['flops']:.2e} | {rate:.1f} | {r['backward_error']:.1e} |")
-    print(f"faer / CHOLMOD {row['faer_over_cholmod']:.2f}, faer / PARDISO {row['faer_over_pardiso']:.2f}, "
-          f"faer at {100 * row['faer']['fraction_of_dgemm']:.0f} % of DGEMM", flush=True)
+    mumps = f", faer / MUMPS {row['faer_over_mumps']:.2f}" if "faer_over_mumps" in row else ""
+    print(f"faer / CHOLMOD {row['faer_over_cholmod']:.2f}, faer / PARDISO {row['faer_over_pardiso']:.2f}"
+          f"{mumps}, faer at {100 * row['faer']['fraction_of_dgemm']:.0f} % of DGEMM", flush=True)
 
 
 if __name__ == "__main__":
