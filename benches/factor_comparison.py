@@ -26,6 +26,8 @@ also given as a fraction of that DGEMM rate.
     python3 -m venv target/pyenv && target/pyenv/bin/pip install numpy scipy pypardiso
     target/pyenv/bin/python benches/factor_comparison.py --presets M,L --repeats 3 \\
         -o benches/results/factor-comparison.json
+
+CI (`.ci/run`) runs it once on the S preset and checks that all four solvers solve.
 """
 
 import argparse
