@@ -181,10 +181,6 @@ def build_mumps(directory):
     return binary, None
 
 
-def mumps_times(binary, mtx, repeats):
-    return run_json([binary, mtx, str(repeats)])
-
-
 def mumps_version():
     """Debian's libmumps-seq-dev version, if dpkg knows one."""
     try:
@@ -269,7 +265,7 @@ def main():
             row["faer"] = fibercell_solver(args.fibercell, mtx, "faer-cholesky", args.repeats)
             row["cholmod"] = fibercell_solver(args.fibercell, mtx, "cholmod", args.repeats)
             row["pardiso"] = pardiso_times(mtx, args.repeats)
-            row["mumps"] = mumps_times(mumps, mtx, args.repeats) if mumps else {"unavailable": why_not}
+            row["mumps"] = run_json([mumps, mtx, str(args.repeats)]) if mumps else {"unavailable": why_not}
             f = row["faer"]
             f["fraction_of_dgemm"] = f["flops"] / f["factorize_seconds"] / 1e9 / machine["dgemm_gflops_two_threads"]
             row["faer_over_cholmod"] = f["factorize_seconds"] / row["cholmod"]["factorize_seconds"]

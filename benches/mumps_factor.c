@@ -43,6 +43,12 @@ static void fail(const char *what) {
   exit(1);
 }
 
+/* malloc or calloc's result, or the end of the program. */
+static void *checked(void *p) {
+  if (!p) fail("out of memory");
+  return p;
+}
+
 /* The whole file, NUL-terminated. */
 static char *slurp(const char *path) {
   FILE *f = fopen(path, "rb");
@@ -51,8 +57,8 @@ static char *slurp(const char *path) {
   long size = ftell(f);
   if (size < 0) fail("cannot read the matrix file");
   fseek(f, 0, SEEK_SET);
-  char *text = malloc(size + 1);
-  if (!text || fread(text, 1, size, f) != (size_t)size) fail("cannot read the matrix file");
+  char *text = checked(malloc(size + 1));
+  if (fread(text, 1, size, f) != (size_t)size) fail("cannot read the matrix file");
   text[size] = 0;
   fclose(f);
   return text;
@@ -87,10 +93,9 @@ int main(int argc, char **argv) {
   long nnz = strtol(end, &end, 10);
   if (n <= 0 || nnz <= 0) fail("bad size line");
   if (ncols != n) fail("the matrix is not square");
-  MUMPS_INT *irn = malloc(nnz * sizeof *irn), *jcn = malloc(nnz * sizeof *jcn);
-  double *a = malloc(nnz * sizeof *a);
-  double *b = calloc(n, sizeof *b), *row_sum = calloc(n, sizeof *row_sum);
-  if (!irn || !jcn || !a || !b || !row_sum) fail("out of memory");
+  MUMPS_INT *irn = checked(malloc(nnz * sizeof *irn)), *jcn = checked(malloc(nnz * sizeof *jcn));
+  double *a = checked(malloc(nnz * sizeof *a));
+  double *b = checked(calloc(n, sizeof *b)), *row_sum = checked(calloc(n, sizeof *row_sum));
   for (long k = 0; k < nnz; k++) {
     irn[k] = strtol(end, &end, 10);
     jcn[k] = strtol(end, &end, 10);
@@ -125,8 +130,8 @@ int main(int argc, char **argv) {
   id.jcn = jcn;
   id.a = a;
 
-  double *analyze = malloc(repeats * sizeof *analyze);
-  double *factorize = malloc(repeats * sizeof *factorize);
+  double *analyze = checked(malloc(repeats * sizeof *analyze));
+  double *factorize = checked(malloc(repeats * sizeof *factorize));
   for (int r = 0; r < repeats; r++) {
     double t = now();
     call(&id, 1);
@@ -141,12 +146,12 @@ int main(int argc, char **argv) {
   double flops = id.rinfog[2];
   int ordering = id.infog[6];
 
-  double *x = malloc(n * sizeof *x);
+  double *x = checked(malloc(n * sizeof *x));
   memcpy(x, b, n * sizeof *x);
   id.rhs = x;
   call(&id, 3);
   /* max |A x − b| / (max row sum · max |x| + max |b|), both triangles. */
-  double *r = calloc(n, sizeof *r);
+  double *r = checked(calloc(n, sizeof *r));
   for (long k = 0; k < nnz; k++) {
     r[irn[k] - 1] += a[k] * x[jcn[k] - 1];
     if (irn[k] != jcn[k]) r[jcn[k] - 1] += a[k] * x[irn[k] - 1];
